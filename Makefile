@@ -1,0 +1,40 @@
+# Set-up and checks. Every install goes through constraints.txt (torch pinned to the local CPU build).
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+PYTEST_ARGS ?=
+
+.PHONY: venv results test test-slow lint benchmark constraints clean
+
+$(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[all,tests]"
+	touch $@
+
+venv: $(VENV)/.installed
+
+# Main job: train GQN on penalized cartpole-swingup and write the learning curve and final evaluation to results/
+results: venv
+	$(BIN)/python -m sb3_gqn.reference_run --out results
+
+lint: venv
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+test: venv lint
+	$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS)
+
+test-slow: venv
+	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)
+
+benchmark: venv
+	$(BIN)/python benchmarks/throughput.py
+
+# Re-pin the whole dependency set from a fresh environment
+constraints:
+	rm -rf /tmp/sb3-gqn-constraints && $(PYTHON) -m venv /tmp/sb3-gqn-constraints
+	/tmp/sb3-gqn-constraints/bin/pip install --quiet -c constraints.txt ".[all,tests]"
+	/tmp/sb3-gqn-constraints/bin/pip freeze | grep -v '^sb3-gqn' | sed 's/+cpu$$//'
+
+clean:
+	rm -rf $(VENV) .pytest_cache .ruff_cache build *.egg-info

@@ -1,0 +1,8 @@
+"""sb3-gqn: Growing Q-Networks (Seyde et al., L4DC 2024) for Stable-Baselines3."""
+
+from sb3_gqn.decqn import DecQN
+from sb3_gqn.gqn import GQN
+
+__version__ = "0.1.0"
+
+__all__ = ["GQN", "DecQN", "__version__"]

@@ -1,0 +1,453 @@
+"""Growing Q-Networks (Seyde et al., L4DC 2024) as a Stable-Baselines3 off-policy algorithm."""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any, ClassVar, TypeVar
+
+import numpy as np
+import torch as th
+import torch.nn.functional as F
+from gymnasium import spaces
+from stable_baselines3.common.buffers import ReplayBuffer
+from stable_baselines3.common.callbacks import BaseCallback, ConvertCallback
+from stable_baselines3.common.noise import ActionNoise
+from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
+from stable_baselines3.common.policies import BasePolicy
+from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedule
+from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
+
+from sb3_gqn.envs import check_action_space, resolve_env
+from sb3_gqn.growth import GROWTH_SCHEDULES, AdaptiveGrowth, GrowthCallback, nested_bin_levels
+from sb3_gqn.masking import active_bin_indices, active_bin_mask, epsilon_greedy
+from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
+from sb3_gqn.targets import decoupled_q_value, double_q_target
+from sb3_gqn.wrappers import BinGrid
+
+SelfGQN = TypeVar("SelfGQN", bound="GQN")
+
+
+def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
+    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`)."""
+    if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
+        return nested_bin_levels(int(bins), int(bins))
+    if isinstance(bins, (tuple, list)) and len(bins) == 2:
+        return nested_bin_levels(bins[0], bins[1])
+    raise TypeError(f"bins must be an int or an (initial, final) pair, got {bins!r}")
+
+
+class GQN(OffPolicyAlgorithm):
+    """
+    Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose
+    resolution grows from coarse to fine during training.
+    Paper: https://arxiv.org/abs/2404.04253 (Seyde et al., L4DC 2024).
+    Defaults follow DecQN's public configuration (Seyde et al., ICLR 2023).
+
+    A ``Box`` action space is discretized to the finest level's bins per dimension
+    (``linspace(low, high, max_bins)``); the critic always holds all of them and a mask restricts
+    greedy actions, exploration and the TD target's max to the active bins (paper eq. 3).
+    ``learn()`` installs a :class:`~sb3_gqn.growth.GrowthCallback` that opens the next level
+    according to ``growth``.
+
+    The env keeps its own action space: ``predict`` returns continuous actions for a ``Box`` env,
+    so SB3's ``evaluate_policy``, ``EvalCallback``, rl-zoo3's ``enjoy`` and video recording work
+    unchanged. The policy and the replay buffer work on bin indices
+    (:attr:`discrete_action_space`), and ``model.policy.predict`` returns indices.
+
+    :param policy: The policy model to use (MlpPolicy, CnnPolicy, MultiInputPolicy, ...)
+    :param env: The environment to learn from (if registered in Gym, can be str)
+    :param learning_rate: The learning rate, it can be a function of the current progress remaining (from 1 to 0)
+    :param buffer_size: size of the replay buffer
+    :param learning_starts: how many steps of the model to collect transitions for before learning starts
+        (actions are drawn uniformly from the active bins until then)
+    :param batch_size: Minibatch size for each gradient update
+    :param tau: the soft update coefficient ("Polyak update", between 0 and 1), default 1 for a hard update
+    :param gamma: the discount factor
+    :param train_freq: Update the model every ``train_freq`` steps. Alternatively pass a tuple of frequency and unit
+        like ``(5, "step")`` or ``(2, "episode")``. The default 8 with ``gradient_steps=1`` is DecQN's
+        32 samples per insert at batch 256.
+    :param gradient_steps: How many gradient steps to do after each rollout (see ``train_freq``).
+        Set to ``-1`` means to do as many gradient steps as steps done in the environment during the rollout.
+    :param replay_buffer_class: Replay buffer class to use. If ``None``, SB3 picks ``NStepReplayBuffer``
+        for ``n_steps > 1`` (``DictReplayBuffer`` for Dict observations, which requires ``n_steps=1``).
+    :param replay_buffer_kwargs: Keyword arguments to pass to the replay buffer on creation.
+    :param optimize_memory_usage: Enable a memory efficient variant of the replay buffer (``n_steps=1`` only)
+    :param n_steps: number of steps of the n-step return (SB3's ``NStepReplayBuffer``)
+    :param target_update_interval: update the target network every ``target_update_interval``
+        **gradient steps** (DecQN's convention; SB3's DQN counts environment steps instead)
+    :param exploration_fraction: fraction of entire training period over which epsilon goes from
+        ``exploration_initial_eps`` to ``exploration_final_eps``
+    :param exploration_initial_eps: initial probability of a random bin per action dimension
+    :param exploration_final_eps: final probability of a random bin per action dimension
+        (DecQN and GQN use a constant 0.1)
+    :param max_grad_norm: The maximum value for the gradient clipping (if None, no clipping)
+    :param bins: bins per action dimension: ``(initial, final)`` grows through the nested levels
+        (``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and MultiDiscrete envs must
+        have ``final`` choices per dimension.
+    :param growth: ``"adaptive"`` (paper eq. 4), ``"linear"`` (level g opens at g / (N + 1) of
+        ``total_timesteps``) or ``None`` (never grow)
+    :param growth_eval_freq: adaptive growth: environment steps between evaluations
+    :param growth_eval_episodes: adaptive growth: greedy episodes per evaluation. They are interleaved
+        in training (their transitions are stored and count as steps), see
+        :class:`~sb3_gqn.growth.AdaptiveGrowth`
+    :param growth_window: adaptive growth: number of past evaluation returns in the moving mean and
+        standard deviation of eq. 4 (a decision needs a full window since the last growth)
+    :param growth_returns: adaptive growth: ``"evaluation"`` (greedy episodes) or ``"training"``
+        (every finished training episode)
+    :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
+        the reported success rate, mean episode length, and mean reward over
+    :param tensorboard_log: the log location for tensorboard (if None, no logging)
+    :param policy_kwargs: additional arguments to be passed to the policy on creation
+        (``net_arch``, ``layer_norm``, ``residual``, ...; see :class:`~sb3_gqn.policies.GQNPolicy`)
+    :param verbose: the verbosity level: 0 no output, 1 info (including growth events), 2 debug
+    :param seed: Seed for the pseudo random generators
+    :param device: Device (cpu, cuda, ...) on which the code should be run.
+        Setting it to auto, the code will be run on the GPU if possible.
+    :param _init_setup_model: Whether or not to build the network at the creation of the instance
+    """
+
+    policy_aliases: ClassVar[dict[str, type[BasePolicy]]] = {
+        "MlpPolicy": MlpPolicy,
+        "CnnPolicy": CnnPolicy,
+        "MultiInputPolicy": MultiInputPolicy,
+    }
+    exploration_schedule: Schedule
+    q_net: DecoupledQNetwork
+    q_net_target: DecoupledQNetwork
+    policy: GQNPolicy
+
+    def __init__(
+        self,
+        policy: str | type[GQNPolicy],
+        env: GymEnv | str,
+        learning_rate: float | Schedule = 1e-4,
+        buffer_size: int = 1_000_000,
+        learning_starts: int = 1000,
+        batch_size: int = 256,
+        tau: float = 1.0,
+        gamma: float = 0.99,
+        train_freq: int | tuple[int, str] = 8,
+        gradient_steps: int = 1,
+        replay_buffer_class: type[ReplayBuffer] | None = None,
+        replay_buffer_kwargs: dict[str, Any] | None = None,
+        optimize_memory_usage: bool = False,
+        n_steps: int = 3,
+        target_update_interval: int = 100,
+        exploration_fraction: float = 0.1,
+        exploration_initial_eps: float = 0.1,
+        exploration_final_eps: float = 0.1,
+        max_grad_norm: float | None = 40.0,
+        bins: int | tuple[int, int] = (2, 9),
+        growth: str | None = "adaptive",
+        growth_eval_freq: int = 5_000,
+        growth_eval_episodes: int = 1,
+        growth_window: int = 3,
+        growth_returns: str = "evaluation",
+        stats_window_size: int = 100,
+        tensorboard_log: str | None = None,
+        policy_kwargs: dict[str, Any] | None = None,
+        verbose: int = 0,
+        seed: int | None = None,
+        device: th.device | str = "auto",
+        _init_setup_model: bool = True,
+    ):
+        if growth not in GROWTH_SCHEDULES:
+            raise ValueError(f"growth must be one of {GROWTH_SCHEDULES}, got {growth!r}")
+        self.bins = bins
+        self.bin_levels = bin_levels_from(bins)
+        env = resolve_env(env)  # type: ignore[assignment]
+        if env is not None:
+            check_action_space(env.action_space)
+        super().__init__(
+            policy,
+            env,
+            learning_rate,
+            buffer_size,
+            learning_starts,
+            batch_size,
+            tau,
+            gamma,
+            train_freq,
+            gradient_steps,
+            action_noise=None,  # exploration is epsilon-greedy over the active bins
+            replay_buffer_class=replay_buffer_class,
+            replay_buffer_kwargs=replay_buffer_kwargs,
+            optimize_memory_usage=optimize_memory_usage,
+            n_steps=n_steps,
+            policy_kwargs=policy_kwargs,
+            stats_window_size=stats_window_size,
+            tensorboard_log=tensorboard_log,
+            verbose=verbose,
+            device=device,
+            seed=seed,
+            sde_support=False,
+            supported_action_spaces=(spaces.Box, spaces.Discrete, spaces.MultiDiscrete),
+            support_multi_env=True,
+        )
+        self.target_update_interval = target_update_interval
+        self.exploration_initial_eps = exploration_initial_eps
+        self.exploration_final_eps = exploration_final_eps
+        self.exploration_fraction = exploration_fraction
+        self.exploration_rate = exploration_initial_eps
+        self.max_grad_norm = max_grad_norm
+        self.growth = growth
+        self.growth_level = 0
+        self.growth_schedule: AdaptiveGrowth | None = None
+        if growth == "adaptive":
+            self.growth_schedule = AdaptiveGrowth(
+                eval_freq=growth_eval_freq,
+                eval_episodes=growth_eval_episodes,
+                window=growth_window,
+                returns_source=growth_returns,
+            )
+        if _init_setup_model:
+            self._setup_model()
+
+    def _setup_model(self) -> None:
+        if isinstance(self.observation_space, spaces.Dict) and self.replay_buffer_class is None and self.n_steps > 1:
+            raise ValueError(
+                f"n_steps={self.n_steps} is not available for Dict observations: SB3's NStepReplayBuffer has no Dict "
+                "variant. Pass n_steps=1, or flatten the observations (gymnasium.wrappers.FlattenObservation)."
+            )
+        with warnings.catch_warnings():
+            if self.replay_buffer_kwargs.get("n_steps") == self.n_steps:
+                # A loaded model already carries the NStepReplayBuffer SB3 chose for it: nothing is ignored.
+                warnings.filterwarnings("ignore", message=r"`n_steps=\d+` is ignored because a custom")
+            # The policy and the replay buffer work on bin indices; the env keeps its own action space.
+            check_action_space(self.action_space)
+            env_action_space = self.action_space
+            if isinstance(env_action_space, spaces.Box):
+                self.action_grid: BinGrid | None = BinGrid(env_action_space, self.bin_levels[-1])
+                self.discrete_action_space: spaces.Space = self.action_grid.discrete_space
+            else:
+                self.action_grid = None
+                self.discrete_action_space = env_action_space
+            self.action_space = self.discrete_action_space
+            try:
+                super()._setup_model()
+            finally:
+                self.action_space = env_action_space
+        self._create_aliases()
+        if self.policy.max_bins != self.bin_levels[-1]:
+            raise ValueError(
+                f"bins={self.bins} needs {self.bin_levels[-1]} choices per action dimension, but the env's action "
+                f"space {self.discrete_action_space} has {self.policy.max_bins}: pass bins={self.policy.max_bins} "
+                "(or a pair ending in it) for a Discrete/MultiDiscrete env"
+            )
+        if not isinstance(self.target_update_interval, int) or self.target_update_interval < 1:
+            raise ValueError(f"target_update_interval must be a positive integer, got {self.target_update_interval!r}")
+        # Copy running stats, see https://github.com/DLR-RM/stable-baselines3/issues/996
+        self.batch_norm_stats = get_parameters_by_name(self.q_net, ["running_"])
+        self.batch_norm_stats_target = get_parameters_by_name(self.q_net_target, ["running_"])
+        self.exploration_schedule = LinearSchedule(
+            self.exploration_initial_eps, self.exploration_final_eps, self.exploration_fraction
+        )
+        self._apply_growth_level()
+
+    def _create_aliases(self) -> None:
+        self.q_net = self.policy.q_net
+        self.q_net_target = self.policy.q_net_target
+
+    # ----------------------------------------------------------------------------------------------
+    # Growth
+    @property
+    def active_bins(self) -> int:
+        """Current resolution: number of active bins per action dimension."""
+        return self.bin_levels[self.growth_level]
+
+    def _apply_growth_level(self) -> None:
+        """Point the policy's mask and the exploration's choices at the current level."""
+        self._active_bin_indices = active_bin_indices(self.bin_levels[-1], self.active_bins)
+        self.policy.set_active_mask(active_bin_mask(self.bin_levels[-1], self.active_bins))
+
+    def grow(self, level: int | None = None, reason: str = "manual") -> None:
+        """Open resolution level ``level`` (default: the next one) for every action dimension.
+
+        Called by the growth callback; can also be called by hand. Levels never shrink.
+
+        :param level: index into :attr:`bin_levels`
+        :param reason: text for the log and the console (``verbose >= 1``)
+        """
+        level = self.growth_level + 1 if level is None else int(level)
+        if not self.growth_level <= level < len(self.bin_levels):
+            raise ValueError(f"Cannot grow from level {self.growth_level} to {level} (levels: {self.bin_levels})")
+        if level == self.growth_level:
+            return
+        previous_bins = self.active_bins
+        self.growth_level = level
+        self._apply_growth_level()
+        if getattr(self, "_logger", None) is not None:  # no logger before the first learn()
+            self.logger.record("growth/active_bins", self.active_bins)
+            self.logger.record("growth/level", self.growth_level)
+            self.logger.record("growth/last_growth_step", self.num_timesteps)
+        if self.verbose >= 1:
+            print(f"GQN growth: {previous_bins} -> {self.active_bins} bins per dimension ({reason})")
+
+    # ----------------------------------------------------------------------------------------------
+    # Acting
+    def _on_step(self) -> None:
+        """Update the exploration rate after every environment step."""
+        self.exploration_rate = self.exploration_schedule(self._current_progress_remaining)
+        self.logger.record("rollout/exploration_rate", self.exploration_rate)
+
+    def _sample_action(
+        self,
+        learning_starts: int,
+        action_noise: ActionNoise | None = None,
+        n_envs: int = 1,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Epsilon-greedy bin indices over the active bins (uniform over them during warm-up).
+
+        :return: the action for the env (continuous for a Box env) and the bin indices stored in the buffer
+        """
+        if self.num_timesteps < learning_starts:
+            if isinstance(self.discrete_action_space, spaces.Discrete):
+                shape: tuple[int, ...] = (n_envs,)
+            else:
+                shape = (n_envs, self.policy.action_dims)
+            indices = self._active_bin_indices[np.random.randint(len(self._active_bin_indices), size=shape)]
+        else:
+            greedy_rows = self.growth_schedule.greedy_envs if self.growth_schedule is not None else None
+            greedy, _ = self.policy.predict(self._last_obs, deterministic=True)  # type: ignore[arg-type]
+            indices = epsilon_greedy(greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows)
+        return self.to_env_action(indices), indices
+
+    def to_env_action(self, indices: np.ndarray) -> np.ndarray:
+        """Bin indices ``(..., action_dims)`` to the env's actions (continuous values for a Box env)."""
+        return indices if self.action_grid is None else self.action_grid.to_continuous(indices)
+
+    def predict(
+        self,
+        observation: np.ndarray | dict[str, np.ndarray],
+        state: tuple[np.ndarray, ...] | None = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = False,
+    ) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:
+        """
+        The env's action for an observation: greedy over the active bins, plus per-dimension
+        epsilon-greedy exploration when ``deterministic=False``. For a Box env the bins are mapped
+        to their continuous values (use ``model.policy.predict`` for the bin indices).
+
+        :param observation: the input observation
+        :param state: The last hidden states (can be None, used in recurrent policies)
+        :param episode_start: The last masks (can be None, used in recurrent policies)
+        :param deterministic: Whether or not to return deterministic actions.
+        :return: the model's action and the next hidden state (used in recurrent policies)
+        """
+        actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
+        if not deterministic:
+            actions = epsilon_greedy(np.asarray(actions), self._active_bin_indices, self.exploration_rate)
+        return self.to_env_action(actions), state
+
+    def _store_transition(
+        self,
+        replay_buffer: ReplayBuffer,
+        buffer_action: np.ndarray,
+        new_obs: np.ndarray | dict[str, np.ndarray],
+        reward: np.ndarray,
+        dones: np.ndarray,
+        infos: list[dict[str, Any]],
+    ) -> None:
+        """Refuse non-finite rewards before they reach the replay buffer (they would poison every Q-value)."""
+        if not np.all(np.isfinite(reward)):
+            raise ValueError(f"The env returned a non-finite reward {reward} at step {self.num_timesteps}")
+        super()._store_transition(replay_buffer, buffer_action, new_obs, reward, dones, infos)
+
+    # ----------------------------------------------------------------------------------------------
+    # Learning
+    def train(self, gradient_steps: int, batch_size: int = 256) -> None:
+        # Switch to train mode (this affects batch norm / dropout)
+        self.policy.set_training_mode(True)
+        # Update learning rate according to schedule
+        self._update_learning_rate(self.policy.optimizer)
+        active_bins_mask = self.policy.active_bins_mask
+
+        losses, q_values = [], []
+        for _ in range(gradient_steps):
+            replay_data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]
+            # n-step replay returns gamma ** k (k = steps actually summed); plain replay uses gamma
+            discounts = replay_data.discounts if replay_data.discounts is not None else self.gamma
+
+            with th.no_grad():
+                # Eq. 3 with double Q (eq. 1): the online net picks a^j in A^g at s_{t+n}, the target net scores it
+                target = double_q_target(
+                    self.q_net(replay_data.next_observations),
+                    self.q_net_target(replay_data.next_observations),
+                    replay_data.rewards,
+                    replay_data.dones,
+                    discounts,
+                    active_bins_mask,
+                )
+
+            # Eq. 2: Q(s_t, a_t) is the mean over dimensions of the chosen bins' utilities
+            actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
+            current = decoupled_q_value(self.q_net(replay_data.observations), actions)
+
+            # Eq. 1: Huber loss on the TD error
+            loss = F.huber_loss(current, target, reduction="mean")
+            losses.append(loss.detach())
+            q_values.append(current.detach().mean())
+
+            self.policy.optimizer.zero_grad(set_to_none=True)
+            loss.backward()
+            if self.max_grad_norm is not None:
+                th.nn.utils.clip_grad_norm_(self.q_net.parameters(), self.max_grad_norm)
+            self.policy.optimizer.step()
+
+            self._n_updates += 1
+            if self._n_updates % self.target_update_interval == 0:
+                polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+                # Copy running stats, see https://github.com/DLR-RM/stable-baselines3/issues/996
+                polyak_update(self.batch_norm_stats, self.batch_norm_stats_target, 1.0)
+
+        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        self.logger.record("train/loss", th.stack(losses).mean().item())
+        self.logger.record("train/q_mean", th.stack(q_values).mean().item())
+        self.logger.record("growth/active_bins", self.active_bins)
+
+    # ----------------------------------------------------------------------------------------------
+    # SB3 hooks
+    def _setup_learn(
+        self,
+        total_timesteps: int,
+        callback: MaybeCallback = None,
+        reset_num_timesteps: bool = True,
+        tb_log_name: str = "run",
+        progress_bar: bool = False,
+    ) -> tuple[int, BaseCallback]:
+        """Install the growth callback in front of the user's callbacks."""
+        env_will_reset = reset_num_timesteps or self._last_obs is None
+        if callback is None:
+            user_callbacks: list[BaseCallback] = []
+        elif isinstance(callback, list):
+            user_callbacks = list(callback)
+        elif isinstance(callback, BaseCallback):
+            user_callbacks = [callback]
+        else:
+            user_callbacks = [ConvertCallback(callback)]
+        callbacks: list[BaseCallback] = [GrowthCallback(env_was_reset=env_will_reset), *user_callbacks]
+        return super()._setup_learn(total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar)
+
+    def learn(
+        self: SelfGQN,
+        total_timesteps: int,
+        callback: MaybeCallback = None,
+        log_interval: int = 4,
+        tb_log_name: str = "GQN",
+        reset_num_timesteps: bool = True,
+        progress_bar: bool = False,
+    ) -> SelfGQN:
+        return super().learn(
+            total_timesteps=total_timesteps,
+            callback=callback,
+            log_interval=log_interval,
+            tb_log_name=tb_log_name,
+            reset_num_timesteps=reset_num_timesteps,
+            progress_bar=progress_bar,
+        )
+
+    def _excluded_save_params(self) -> list[str]:
+        return [*super()._excluded_save_params(), "q_net", "q_net_target", "_active_bin_indices", "action_grid"]
+
+    def _get_torch_save_params(self) -> tuple[list[str], list[str]]:
+        return ["policy", "policy.optimizer"], []

@@ -1,0 +1,241 @@
+"""When to open the next, finer level of nested bins (paper section 4).
+
+* :func:`nested_bin_levels` lists the resolutions ``2 -> 3 -> 5 -> 9`` (each level doubles the
+  number of intervals between the action bounds).
+* ``growth="linear"``: :func:`linear_growth_level` opens level ``g`` (0-based, level 0 is
+  active from the start) once ``g / (N + 1)`` of the total timesteps have passed, ``N`` being the
+  number of levels.
+* ``growth="adaptive"``: :class:`AdaptiveGrowth` keeps a moving window of returns and grows when
+  the current return falls below the threshold of paper eq. 4 (:func:`adaptive_threshold`).
+
+:class:`GrowthCallback` drives either schedule during ``learn()``; GQN installs it itself.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+if TYPE_CHECKING:
+    from sb3_gqn.gqn import GQN
+
+GROWTH_SCHEDULES = ("adaptive", "linear", None)
+RETURN_SOURCES = ("evaluation", "training")
+
+
+def nested_bin_levels(initial: int, final: int) -> list[int]:
+    """The nested resolutions from ``initial`` to ``final`` bins per dimension.
+
+    Each level doubles the number of intervals: ``n -> 2 n - 1``. ``(2, 9)`` gives
+    ``[2, 3, 5, 9]``, ``(9, 65)`` gives ``[9, 17, 33, 65]``, ``(3, 9)`` gives ``[3, 5, 9]``,
+    ``(9, 9)`` gives ``[9]``.
+
+    :raises ValueError: if ``final`` cannot be reached by doubling from ``initial``
+        (e.g. ``(2, 8)`` or ``(4, 9)``), or either is below 2
+    """
+    for name, value in (("initial", initial), ("final", final)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise TypeError(f"bins must be integers, got {name}={value!r}")
+    initial, final = int(initial), int(final)
+    if initial < 2:
+        raise ValueError(f"The coarsest level needs at least 2 bins per dimension, got {initial}")
+    if final < initial:
+        raise ValueError(f"bins=({initial}, {final}): the final resolution must not be below the initial one")
+    levels = [initial]
+    while levels[-1] < final:
+        levels.append(2 * levels[-1] - 1)
+    if levels[-1] != final:
+        raise ValueError(
+            f"bins=({initial}, {final}) cannot be nested: doubling the intervals from {initial} bins gives "
+            f"{levels[:-1]} then {levels[-1]}, never {final}. Valid pairs are e.g. (2, 9), (3, 9), (9, 65)."
+        )
+    return levels
+
+
+def adaptive_threshold(mean: float, std: float) -> float:
+    """Paper eq. 4: ``(1 - 0.05 sgn(mu)) mu + 0.9 sigma``.
+
+    ``mean`` and ``std`` are the moving-window mean and standard deviation of past returns;
+    growth happens when the current return falls below this value (stagnation).
+    """
+    return (1.0 - 0.05 * float(np.sign(mean))) * mean + 0.9 * std
+
+
+def linear_growth_level(num_timesteps: int, total_timesteps: int, n_levels: int) -> int:
+    """Level index the linear schedule has reached: level ``g`` opens at ``g / (N + 1)`` of training.
+
+    With ``N = 4`` levels and 100 000 total steps, levels 1, 2, 3 open at 20 000, 40 000, 60 000.
+    """
+    if total_timesteps <= 0:
+        return 0
+    reached = math.floor(num_timesteps * (n_levels + 1) / total_timesteps)
+    return max(0, min(n_levels - 1, reached))
+
+
+@dataclass
+class GrowthDecision:
+    """Outcome of one adaptive check: the compared return and the eq. 4 threshold (None while warming up)."""
+
+    current_return: float
+    threshold: float | None
+    window_mean: float | None
+    window_std: float | None
+    grow: bool
+
+
+@dataclass
+class AdaptiveGrowth:
+    """State of the adaptive schedule (saved with the model).
+
+    Returns come either from greedy evaluation episodes (``returns_source="evaluation"``) or from
+    every finished training episode (``"training"``). Evaluation episodes are interleaved with
+    training: every ``eval_freq`` environment steps, the next ``eval_episodes`` episodes that start
+    act greedily over the active bins (no epsilon). Their transitions still go to the replay buffer
+    and count as environment steps, so no separate evaluation env or extra budget is needed, and it
+    works for any env, wrapper stack or VecEnv that GQN trains on.
+
+    The window holds the last ``window`` returns since the most recent growth; a decision is made
+    once it is full. After a growth the window restarts, so the new level is judged on its own
+    returns and one dip cannot cascade through all levels.
+
+    :param eval_freq: environment steps between evaluations
+    :param eval_episodes: greedy episodes averaged into one evaluation return
+    :param window: number of past returns in the moving mean and standard deviation
+    :param returns_source: ``"evaluation"`` or ``"training"``
+    """
+
+    eval_freq: int = 5_000
+    eval_episodes: int = 1
+    window: int = 3
+    returns_source: str = "evaluation"
+    history: list[float] = field(default_factory=list)
+    next_eval_step: int = 0
+    pending_episodes: int = 0
+    finished_eval_returns: list[float] = field(default_factory=list)
+    greedy_envs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    episode_returns: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:
+        if self.returns_source not in RETURN_SOURCES:
+            raise ValueError(f"growth_returns must be one of {RETURN_SOURCES}, got {self.returns_source!r}")
+        for name in ("eval_freq", "eval_episodes", "window"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"growth {name} must be a positive integer, got {value!r}")
+        if self.next_eval_step == 0:
+            self.next_eval_step = self.eval_freq
+
+    def start(self, n_envs: int, env_was_reset: bool) -> None:
+        """Prepare per-env bookkeeping at the start of ``learn()``.
+
+        When the env was reset (new run, ``set_env``, load), the episodes in progress are gone: their
+        partial returns are dropped and greedy evaluation episodes that were running are started again.
+        """
+        if env_was_reset or len(self.greedy_envs) != n_envs:
+            self.pending_episodes += int(self.greedy_envs.sum())
+            self.greedy_envs = np.zeros(n_envs, dtype=bool)
+            self.episode_returns = np.zeros(n_envs, dtype=np.float64)
+            for env_idx in range(n_envs):
+                self._start_episode(env_idx)
+
+    def _start_episode(self, env_idx: int) -> None:
+        if self.pending_episodes > 0:
+            self.greedy_envs[env_idx] = True
+            self.pending_episodes -= 1
+
+    def observe(self, rewards: np.ndarray, dones: np.ndarray, num_timesteps: int) -> list[GrowthDecision]:
+        """Account one vectorised env step; return the decisions made at episodes that just ended."""
+        evaluating = self.returns_source == "evaluation"
+        if evaluating and num_timesteps >= self.next_eval_step:
+            self.next_eval_step = (num_timesteps // self.eval_freq + 1) * self.eval_freq
+            if self.pending_episodes == 0 and not self.greedy_envs.any() and not self.finished_eval_returns:
+                self.pending_episodes = self.eval_episodes
+        self.episode_returns += rewards
+        decisions = []
+        for env_idx in np.flatnonzero(dones):
+            episode_return = float(self.episode_returns[env_idx])
+            self.episode_returns[env_idx] = 0.0
+            if not evaluating:
+                decisions.append(self.decide(episode_return))
+            elif self.greedy_envs[env_idx]:
+                self.greedy_envs[env_idx] = False
+                self.finished_eval_returns.append(episode_return)
+                if len(self.finished_eval_returns) == self.eval_episodes:
+                    decisions.append(self.decide(float(np.mean(self.finished_eval_returns))))
+                    self.finished_eval_returns = []
+            self._start_episode(int(env_idx))
+        return decisions
+
+    def decide(self, current_return: float) -> GrowthDecision:
+        """Compare ``current_return`` with eq. 4 over the window; grow when it falls below."""
+        if len(self.history) < self.window:
+            self.history.append(current_return)
+            return GrowthDecision(current_return, None, None, None, grow=False)
+        window_mean = float(np.mean(self.history))
+        window_std = float(np.std(self.history))
+        threshold = adaptive_threshold(window_mean, window_std)
+        grow = current_return < threshold
+        if grow:
+            self.history = []
+        else:
+            self.history = [*self.history[1:], current_return]
+        return GrowthDecision(current_return, threshold, window_mean, window_std, grow)
+
+    def stop_evaluating(self) -> None:
+        """No further levels: stop scheduling greedy episodes."""
+        self.pending_episodes = 0
+        self.finished_eval_returns = []
+        self.greedy_envs[:] = False
+
+
+class GrowthCallback(BaseCallback):
+    """Applies the model's growth schedule after every environment step (installed by ``GQN.learn``).
+
+    :param env_was_reset: whether ``learn()`` reset the environment (episodes in progress are lost)
+    """
+
+    model: GQN
+
+    def __init__(self, env_was_reset: bool = True, verbose: int = 0):
+        super().__init__(verbose)
+        self.env_was_reset = env_was_reset
+
+    def _on_training_start(self) -> None:
+        schedule = self.model.growth_schedule
+        if isinstance(schedule, AdaptiveGrowth):
+            schedule.start(self.model.n_envs, self.env_was_reset)
+        self.model.logger.record("growth/active_bins", self.model.active_bins)
+
+    def _on_step(self) -> bool:
+        model = self.model
+        if model.growth_level >= len(model.bin_levels) - 1:
+            return True
+        if model.growth == "linear":
+            target = linear_growth_level(model.num_timesteps, model._total_timesteps, len(model.bin_levels))
+            if target > model.growth_level:
+                model.grow(target, reason=f"linear schedule at step {model.num_timesteps}")
+            return True
+        schedule = model.growth_schedule
+        assert isinstance(schedule, AdaptiveGrowth)
+        rewards = self.locals["rewards"]
+        if model._vec_normalize_env is not None:
+            rewards = model._vec_normalize_env.get_original_reward()
+        for decision in schedule.observe(rewards, self.locals["dones"], model.num_timesteps):
+            model.logger.record("growth/return", decision.current_return)
+            if decision.threshold is not None:
+                model.logger.record("growth/threshold", decision.threshold)
+            if decision.grow and model.growth_level < len(model.bin_levels) - 1:
+                model.grow(
+                    model.growth_level + 1,
+                    reason=(
+                        f"{schedule.returns_source} return {decision.current_return:.2f} < "
+                        f"eq. 4 threshold {decision.threshold:.2f} at step {model.num_timesteps}"
+                    ),
+                )
+                if model.growth_level >= len(model.bin_levels) - 1:
+                    schedule.stop_evaluating()
+        return True

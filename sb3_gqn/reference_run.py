@@ -1,0 +1,137 @@
+"""The project's main job: train GQN on a penalized DeepMind Control task and write its results.
+
+    python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, 100k steps
+    python -m sb3_gqn.reference_run --timesteps 20000 --out /tmp/smoke
+
+Writes to ``<out>/<run name>/``: ``learning_curve.csv`` (greedy evaluation every ``--eval-freq``
+steps: return, task return, penalty, active bins, training wall time), ``learning_curve.png``,
+``final_evaluation.json`` and the trained ``model.zip``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import platform
+import time
+from pathlib import Path
+from typing import Any
+
+os.environ.setdefault("MUJOCO_GL", "disable")  # no rendering: keep dm_control off any GL backend
+
+import torch as th
+from stable_baselines3.common.monitor import Monitor
+
+from sb3_gqn import GQN, DecQN, __version__
+from sb3_gqn.envs import make_env
+from sb3_gqn.evaluation import LearningCurveCallback, evaluate
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--env", default="dm_control/cartpole-swingup-v0", help="gymnasium env id")
+    parser.add_argument("--penalty", type=float, default=0.1, help="action penalty coefficient c (0 for none)")
+    parser.add_argument("--algo", choices=["gqn", "decqn"], default="gqn")
+    parser.add_argument("--bins", type=int, nargs="+", default=[2, 9], help="initial and final bins (one int: static)")
+    parser.add_argument("--growth", default="adaptive", choices=["adaptive", "linear", "none"])
+    parser.add_argument("--timesteps", type=int, default=100_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")
+    parser.add_argument("--eval-episodes", type=int, default=5, help="episodes per learning-curve evaluation")
+    parser.add_argument("--final-episodes", type=int, default=10, help="episodes of the final evaluation")
+    parser.add_argument("--out", default="results", help="output folder")
+    parser.add_argument("--verbose", type=int, default=1)
+    return parser.parse_args(argv)
+
+
+def run_name(args: argparse.Namespace) -> str:
+    env = args.env.split("/")[-1].removesuffix("-v0").removesuffix("-v1")
+    bins = "-".join(str(b) for b in args.bins)
+    growth = f"_{args.growth}" if args.algo == "gqn" and len(args.bins) > 1 else ""
+    return f"{args.algo}{growth}_bins{bins}_{env}_p{args.penalty:g}_seed{args.seed}"
+
+
+def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    steps = [row["step"] for row in rows]
+    figure, axis = plt.subplots(figsize=(6.4, 4.0))
+    axis.plot(steps, [row["return_mean"] for row in rows], marker="o", label="return (penalized)")
+    axis.plot(steps, [row["task_return_mean"] for row in rows], marker=".", linestyle="--", label="task return")
+    previous_bins = None
+    for row in rows:
+        if row["active_bins"] is not None and row["active_bins"] != previous_bins:
+            axis.axvline(row["step"], color="grey", alpha=0.3)
+            axis.annotate(f"{row['active_bins']} bins", (row["step"], axis.get_ylim()[0]), rotation=90, fontsize=7)
+            previous_bins = row["active_bins"]
+    axis.set_xlabel("environment steps")
+    axis.set_ylabel("episode return (greedy)")
+    axis.set_title(title, fontsize=9)
+    axis.grid(alpha=0.3)
+    axis.legend(loc="lower right")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    args = parse_args(argv)
+    out = Path(args.out) / run_name(args)
+    out.mkdir(parents=True, exist_ok=True)
+    bins: int | tuple[int, int] = args.bins[0] if len(args.bins) == 1 else (args.bins[0], args.bins[1])
+
+    env = Monitor(make_env(args.env, action_penalty=args.penalty))
+    eval_env = Monitor(make_env(args.env, action_penalty=args.penalty))
+    common = dict(seed=args.seed, verbose=0)
+    if args.algo == "decqn":
+        model: GQN = DecQN("MlpPolicy", env, bins=int(args.bins[-1]), **common)
+    else:
+        growth = None if args.growth == "none" else args.growth
+        model = GQN("MlpPolicy", env, bins=bins, growth=growth, **common)
+    model.verbose = args.verbose  # growth events on the console, without SB3's per-episode tables
+
+    curve = LearningCurveCallback(eval_env, eval_freq=args.eval_freq, n_episodes=args.eval_episodes, verbose=args.verbose)
+    started = time.perf_counter()
+    model.learn(args.timesteps, callback=curve)
+    wall_seconds = time.perf_counter() - started
+    final = evaluate(model, eval_env, n_episodes=args.final_episodes)
+
+    model.save(out / "model.zip")
+    write_csv(out / "learning_curve.csv", curve.rows)
+    plot_learning_curve(out / "learning_curve.png", curve.rows, f"{run_name(args)} (sb3-gqn {__version__})")
+    summary = {
+        "run": run_name(args),
+        "args": vars(args),
+        "timesteps": model.num_timesteps,
+        "gradient_steps": model._n_updates,
+        "wall_seconds": wall_seconds,
+        "train_seconds": curve.rows[-1]["train_seconds"] if curve.rows else wall_seconds,
+        "env_steps_per_second": model.num_timesteps / wall_seconds,
+        "final_active_bins": model.active_bins,
+        "final_evaluation": final.as_dict(),
+        "machine": {"python": platform.python_version(), "torch": th.__version__, "threads": th.get_num_threads()},
+    }
+    with open(out / "final_evaluation.json", "w") as handle:
+        json.dump(summary, handle, indent=2)
+    if args.verbose:
+        print(
+            f"final: return {final.return_mean:.1f} +- {final.return_std:.1f}, task return {final.task_return_mean:.1f}, "
+            f"{model.active_bins} bins, {wall_seconds:.0f}s wall -> {out}"
+        )
+    return summary
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,48 @@
+"""The decoupled, masked double-Q learning target (paper eqs. 1-3) as pure tensor functions."""
+
+from __future__ import annotations
+
+import torch as th
+
+from sb3_gqn.masking import masked_argmax
+
+
+def decoupled_q_value(q_values: th.Tensor, actions: th.Tensor) -> th.Tensor:
+    """Paper eq. 2: ``Q(s, a) = (1 / M) sum_j Q^j(s, a^j)``.
+
+    :param q_values: utilities ``(batch, action_dims, max_bins)``
+    :param actions: bin indices ``(batch, action_dims)``
+    :return: joint action values ``(batch,)``
+    """
+    chosen = q_values.gather(dim=2, index=actions.long().unsqueeze(-1)).squeeze(-1)
+    return chosen.mean(dim=1)
+
+
+def double_q_target(
+    next_q_online: th.Tensor,
+    next_q_target: th.Tensor,
+    rewards: th.Tensor,
+    dones: th.Tensor,
+    discounts: th.Tensor | float,
+    active_bins_mask: th.Tensor,
+) -> th.Tensor:
+    """Paper eq. 3 with double Q-learning (eq. 1): the n-step bootstrapped target ``y``.
+
+    ``y = R^(n) + gamma^n (1 - done) (1 / M) sum_j Q^j_target(s', argmax_{a in A^g} Q^j_online(s', a))``.
+    The online network selects each dimension's bin among the active bins ``A^g``; the target
+    network evaluates it.
+
+    :param next_q_online: online utilities at ``s_{t+n}``, ``(batch, action_dims, max_bins)``
+    :param next_q_target: target-network utilities at ``s_{t+n}``, same shape
+    :param rewards: discounted n-step reward sums ``R^(n)``, ``(batch,)`` or ``(batch, 1)``
+    :param dones: 1.0 where the episode terminated within the n steps (not truncated)
+    :param discounts: ``gamma ** k`` with ``k`` the number of steps actually summed (SB3's
+        ``NStepReplayBuffer``), or a scalar ``gamma`` for 1-step buffers
+    :param active_bins_mask: boolean ``(max_bins,)``, ``True`` = active
+    :return: targets ``(batch,)``
+    """
+    next_actions = masked_argmax(next_q_online, active_bins_mask)
+    next_values = decoupled_q_value(next_q_target, next_actions)
+    if isinstance(discounts, th.Tensor):
+        discounts = discounts.reshape(-1)
+    return rewards.reshape(-1) + (1.0 - dones.reshape(-1)) * discounts * next_values

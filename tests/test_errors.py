@@ -1,0 +1,114 @@
+"""Bad input raises a clear error naming the problem."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium import spaces
+
+from sb3_gqn import GQN, DecQN
+from tests.envs import DecliningEnv, NaNRewardEnv
+
+
+def env_with_action_space(action_space: spaces.Space) -> gym.Env:
+    env = DecliningEnv()
+    env.action_space = action_space
+    return env
+
+
+@pytest.mark.parametrize(
+    "action_space",
+    [
+        spaces.Dict({"a": spaces.Discrete(2)}),
+        spaces.Tuple((spaces.Discrete(2), spaces.Discrete(2))),
+        spaces.Text(5),
+        spaces.MultiBinary(3),
+    ],
+    ids=["Dict", "Tuple", "Text", "MultiBinary"],
+)
+def test_unsupported_action_spaces(action_space):
+    with pytest.raises(TypeError, match=type(action_space).__name__):
+        GQN("MlpPolicy", env_with_action_space(action_space))
+
+
+def test_infinite_box_bounds():
+    with pytest.raises(ValueError, match="finite action bounds"):
+        GQN("MlpPolicy", env_with_action_space(spaces.Box(-np.inf, np.inf, (2,))))
+
+
+def test_half_infinite_box_bounds():
+    with pytest.raises(ValueError, match="finite action bounds"):
+        GQN("MlpPolicy", env_with_action_space(spaces.Box(np.array([-1.0, 0.0]), np.array([1.0, np.inf]))))
+
+
+@pytest.mark.parametrize("bins", [(2, 8), (4, 9), (3, 10)])
+def test_bins_that_cannot_nest(bins):
+    with pytest.raises(ValueError, match="cannot be nested"):
+        GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+@pytest.mark.parametrize("bins", [1, (0, 9), (9, 2)])
+def test_bins_out_of_range(bins):
+    with pytest.raises(ValueError):
+        GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+@pytest.mark.parametrize("bins", ["9", (2, 5, 9), 2.5, None])
+def test_bins_of_wrong_type(bins):
+    with pytest.raises(TypeError, match="bins"):
+        GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+@pytest.mark.parametrize("growth", ["exponential", "Linear", True, 1])
+def test_unknown_growth(growth):
+    with pytest.raises(ValueError, match="growth"):
+        GQN("MlpPolicy", DecliningEnv(), growth=growth)
+
+
+def test_unknown_growth_returns():
+    with pytest.raises(ValueError, match="growth_returns"):
+        GQN("MlpPolicy", DecliningEnv(), growth_returns="episodes")
+
+
+def test_discrete_env_with_other_bin_count():
+    with pytest.raises(ValueError, match="bins=2"):
+        GQN("MlpPolicy", "CartPole-v1", bins=(2, 9))
+
+
+def test_uneven_multidiscrete():
+    with pytest.raises(ValueError, match="same number of bins"):
+        GQN("MlpPolicy", env_with_action_space(spaces.MultiDiscrete([3, 5])), bins=5)
+
+
+def test_nan_reward():
+    model = GQN("MlpPolicy", NaNRewardEnv(), policy_kwargs=dict(net_arch=[8]), learning_starts=0)
+    with pytest.raises(ValueError, match="non-finite reward"):
+        model.learn(20)
+
+
+def test_load_onto_other_action_shape(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(action_dims=2), policy_kwargs=dict(net_arch=[8])).save(tmp_path / "model")
+    with pytest.raises(ValueError, match=r"[Aa]ction spaces do not match"):
+        GQN.load(tmp_path / "model", env=DecliningEnv(action_dims=4))
+
+
+def test_load_with_other_bins_discretizes_to_saved_bins(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), bins=(9, 65), policy_kwargs=dict(net_arch=[8])).save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model", env=DecliningEnv())
+    assert loaded.discrete_action_space == spaces.MultiDiscrete([65, 65])
+    assert loaded.bin_levels == [9, 17, 33, 65]
+
+
+def test_decqn_rejects_growth_and_pairs():
+    with pytest.raises(ValueError, match="static"):
+        DecQN("MlpPolicy", DecliningEnv(), growth="linear")
+    with pytest.raises(TypeError, match="single int"):
+        DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9))
+
+
+def test_grow_backwards_or_past_the_end():
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8]))
+    model.grow(3)
+    with pytest.raises(ValueError, match="Cannot grow"):
+        model.grow(1)
+    with pytest.raises(ValueError, match="Cannot grow"):
+        model.grow()

@@ -1,0 +1,240 @@
+"""Behaviour of the GQN algorithm: masking during acting, growth, save/load, VecEnvs, Dict observations."""
+
+import numpy as np
+import pytest
+import torch as th
+from gymnasium import spaces
+from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.logger import configure
+
+from sb3_gqn import GQN, DecQN
+from sb3_gqn.growth import AdaptiveGrowth, linear_growth_level
+from sb3_gqn.masking import active_bin_indices
+from tests.envs import DecliningEnv
+
+SMALL = dict(policy_kwargs=dict(net_arch=[32, 32]), learning_starts=100, buffer_size=10_000, batch_size=32, seed=0)
+
+
+def test_box_env_is_discretized_to_the_finest_level():
+    model = GQN("MlpPolicy", "Pendulum-v1", bins=(2, 9), **SMALL)
+    assert model.action_space == spaces.Box(-2.0, 2.0, (1,))  # the env keeps its action space
+    assert model.discrete_action_space == spaces.MultiDiscrete([9])
+    assert model.bin_levels == [2, 3, 5, 9]
+    assert model.active_bins == 2
+    assert model.policy.active_bins_mask.tolist() == [True] + [False] * 7 + [True]
+
+
+def test_stored_actions_never_leave_the_active_set_before_and_after_growth():
+    total = 2_000
+    model = GQN("MlpPolicy", "Pendulum-v1", growth="linear", exploration_initial_eps=0.5, exploration_final_eps=0.5, **SMALL)
+    model.learn(total)
+    assert model.active_bins == 9
+    stored = model.replay_buffer.actions[:total, 0, 0]
+    for position, action in enumerate(stored):
+        # the action stored at position p was chosen when p steps had been taken
+        level = linear_growth_level(position, total, 4)
+        assert action in active_bin_indices(9, model.bin_levels[level]), (position, action, level)
+    # and growth really widened the actions: bins outside {0, 4, 8} appear once 5 bins are active (step 800)
+    assert set(np.unique(stored[:400])) <= {0, 8}
+    assert set(np.unique(stored[900:])) & {2, 6}
+    assert set(np.unique(stored[1300:])) & {1, 3, 5, 7}
+
+
+def test_predict_stays_in_active_set():
+    model = GQN("MlpPolicy", "Pendulum-v1", growth=None, bins=(3, 9), exploration_initial_eps=1.0, **SMALL)
+    observations = np.random.default_rng(0).normal(size=(500, 3)).astype(np.float32)
+    for deterministic in (True, False):
+        actions, _ = model.predict(observations, deterministic=deterministic)
+        assert actions.shape == (500, 1)
+        assert set(np.unique(actions)) <= {-2.0, 0.0, 2.0}  # bins 0, 4, 8 of linspace(-2, 2, 9)
+    actions, _ = model.predict(observations, deterministic=False)
+    assert set(np.unique(actions)) == {-2.0, 0.0, 2.0}  # epsilon = 1 reaches every active bin
+    indices, _ = model.policy.predict(observations, deterministic=True)
+    assert set(np.unique(indices)) <= {0, 4, 8}
+    single, _ = model.predict(observations[0], deterministic=True)
+    assert single.shape == (1,) and single.dtype == np.float32
+
+
+def test_linear_growth_steps_in_a_run():
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", **SMALL)
+    seen = {}
+
+    def record(locals_, globals_):
+        seen.setdefault(model.active_bins, model.num_timesteps)
+        return True
+
+    model.learn(1_000, callback=record)
+    # N = 4: levels open at 200, 400, 600; the callback runs after the growth callback of the same step
+    assert seen == {2: 1, 3: 200, 5: 400, 9: 600}
+
+
+@pytest.mark.parametrize("returns_source", ["evaluation", "training"])
+def test_adaptive_growth_happens_when_returns_stagnate(returns_source):
+    model = GQN(
+        "MlpPolicy",
+        DecliningEnv(length=5),
+        growth="adaptive",
+        growth_eval_freq=10,
+        growth_window=2,
+        growth_returns=returns_source,
+        verbose=1,
+        **SMALL,
+    )
+    model.learn(400)
+    # returns fall by 1 every episode: each check after a full window is below eq. 4's threshold
+    assert model.active_bins == 9
+    assert isinstance(model.growth_schedule, AdaptiveGrowth)
+
+
+def test_adaptive_evaluation_episodes_are_greedy():
+    # No gradient steps: the network stays fixed, so greedy actions can be recomputed afterwards.
+    model = GQN(
+        "MlpPolicy",
+        DecliningEnv(length=5, action_dims=4),
+        growth="adaptive",
+        growth_eval_freq=50,
+        growth_window=1000,  # never decides: we only look at the actions
+        exploration_initial_eps=1.0,
+        exploration_final_eps=1.0,
+        gradient_steps=0,
+        **{**SMALL, "learning_starts": 0},
+    )
+    greedy_flags = []
+
+    def record(locals_, globals_):
+        greedy_flags.append(bool(model.growth_schedule.greedy_envs[0]))
+        return True
+
+    model.learn(500, callback=record)
+    steps = model.num_timesteps
+    # the flag recorded after step t is the one the action of step t + 1 used
+    flags = np.array([False, *greedy_flags[:-1]])
+    actions = model.replay_buffer.actions[:steps, 0]
+    greedy, _ = model.policy.predict(model.replay_buffer.observations[:steps, 0], deterministic=True)
+    # evaluations are due every 50 steps; each runs the next 5-step episode greedily (the last one is cut at 504)
+    assert flags.sum() == 9 * 5 + 4
+    np.testing.assert_array_equal(actions[flags], greedy[flags])
+    # exploratory steps (epsilon = 1) are uniform over {0, 8}: half of the entries differ from greedy
+    assert np.mean(actions[~flags] != greedy[~flags]) == pytest.approx(0.5, abs=0.05)
+
+
+def test_save_load_round_trip(tmp_path):
+    # a window longer than the run: the schedule collects statistics but never decides
+    model = GQN("MlpPolicy", DecliningEnv(), growth="adaptive", growth_eval_freq=10, growth_window=100, **SMALL)
+    model.learn(150)
+    assert len(model.growth_schedule.history) >= 10
+    model.grow(2)
+    observations = np.random.default_rng(0).normal(size=(64, 3)).astype(np.float32)
+    expected, _ = model.predict(observations, deterministic=True)
+    model.save(tmp_path / "gqn")
+
+    loaded = GQN.load(tmp_path / "gqn", env=DecliningEnv())
+    assert loaded.growth_level == 2 and loaded.active_bins == 5
+    assert loaded.policy.active_bins_mask.tolist() == model.policy.active_bins_mask.tolist()
+    assert loaded.growth_schedule.history == model.growth_schedule.history
+    assert loaded.growth_schedule.next_eval_step == model.growth_schedule.next_eval_step
+    np.testing.assert_array_equal(loaded.predict(observations, deterministic=True)[0], expected)
+    original_state = model.policy.optimizer.state_dict()["state"]
+    loaded_state = loaded.policy.optimizer.state_dict()["state"]
+    assert original_state.keys() == loaded_state.keys()
+    for key in original_state:
+        assert th.equal(original_state[key]["exp_avg"], loaded_state[key]["exp_avg"])
+    # the resumed run continues from the saved level
+    loaded.learn(100, reset_num_timesteps=False)
+    assert loaded.active_bins >= 5
+    assert loaded.num_timesteps >= model.num_timesteps + 100
+
+
+def test_load_onto_env_with_other_action_shape_fails(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=2), **SMALL)
+    model.save(tmp_path / "gqn")
+    with pytest.raises(ValueError, match=r"[Aa]ction spaces do not match"):
+        GQN.load(tmp_path / "gqn", env=DecliningEnv(action_dims=3))
+
+
+def test_set_env_checks_spaces():
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=2), **SMALL)
+    model.set_env(DecliningEnv(action_dims=2))
+    model.learn(50)
+    with pytest.raises(ValueError):
+        model.set_env(DecliningEnv(action_dims=3))
+
+
+def test_multiple_envs():
+    env = make_vec_env(DecliningEnv, n_envs=2)
+    model = GQN("MlpPolicy", env, growth="linear", **SMALL)
+    model.learn(600)
+    assert model.n_envs == 2 and model.active_bins == 9
+    stored = model.replay_buffer.actions[: model.replay_buffer.pos]
+    assert stored.shape[1:] == (2, 2)
+
+
+def test_adaptive_growth_with_multiple_envs():
+    env = make_vec_env(DecliningEnv, n_envs=2)
+    model = GQN("MlpPolicy", env, growth="adaptive", growth_eval_freq=10, growth_window=2, growth_eval_episodes=2, **SMALL)
+    model.learn(600)
+    assert model.active_bins == 9
+
+
+def test_dict_observations_with_multi_input_policy():
+    model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, growth="linear", **SMALL)
+    model.learn(300)
+    assert model.active_bins == 9
+    action, _ = model.predict({"state": np.zeros(3, np.float32), "time": np.zeros(1, np.float32)}, deterministic=True)
+    assert action.shape == (2,) and set(action.tolist()) <= set(np.linspace(-1, 1, 9).tolist())
+
+
+def test_dict_observations_with_n_step_is_a_clear_error():
+    with pytest.raises(ValueError, match="n_steps"):
+        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=3, **SMALL)
+
+
+def test_discrete_env():
+    model = GQN("MlpPolicy", "CartPole-v1", bins=2, growth=None, **SMALL)
+    model.learn(300)
+    action, _ = model.predict(np.zeros(4, np.float32), deterministic=True)
+    assert action.shape == () and int(action) in (0, 1)
+
+
+def test_decqn_is_static():
+    model = DecQN("MlpPolicy", DecliningEnv(), bins=9, **SMALL)
+    assert model.bin_levels == [9] and model.growth is None
+    model.learn(300)
+    assert model.active_bins == 9
+    bang_bang = DecQN("MlpPolicy", DecliningEnv(), bins=2, **SMALL)
+    assert bang_bang.discrete_action_space == spaces.MultiDiscrete([2, 2])
+    actions, _ = bang_bang.predict(np.zeros((50, 3), np.float32), deterministic=False)
+    assert set(np.unique(actions)) <= {-1.0, 1.0}
+
+
+def test_growth_is_logged(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", **SMALL)
+    model.set_logger(configure(str(tmp_path), ["csv"]))
+    model.learn(1_000, log_interval=10)
+    import csv
+
+    with open(tmp_path / "progress.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    logged_bins = [int(float(row["growth/active_bins"])) for row in rows if row.get("growth/active_bins")]
+    assert logged_bins[0] < 9 and logged_bins[-1] == 9
+
+
+def test_progress_bar_and_tensorboard(tmp_path):
+    pytest.importorskip("tqdm")
+    pytest.importorskip("rich")
+    pytest.importorskip("tensorboard")
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", tensorboard_log=str(tmp_path), **SMALL)
+    model.learn(300, progress_bar=True)
+    assert any(path.name.startswith("events.out.tfevents") for path in tmp_path.rglob("*"))
+
+
+def test_sb3_evaluation_tools_work_on_the_box_env():
+    from stable_baselines3.common.evaluation import evaluate_policy
+    from stable_baselines3.common.monitor import Monitor
+
+    from sb3_gqn.wrappers import ActionPenalty
+
+    model = GQN("MlpPolicy", DecliningEnv(), **SMALL)
+    rewards, _ = evaluate_policy(model, Monitor(ActionPenalty(DecliningEnv(), coef=0.1)), 2, return_episode_rewards=True)
+    # episode 1 of a fresh env: reward -1/5 per step over 5 steps, penalty 0.1 * 2 (both dims at a bang-bang bin)
+    assert rewards[0] == pytest.approx(-1.0 - 5 * 0.2)

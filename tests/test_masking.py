@@ -1,0 +1,90 @@
+"""Nested levels, masks and masked max/argmax against hand-computed values."""
+
+import itertools
+
+import numpy as np
+import pytest
+import torch as th
+
+from sb3_gqn.growth import nested_bin_levels
+from sb3_gqn.masking import active_bin_indices, active_bin_mask, epsilon_greedy, masked_argmax, masked_max
+
+
+@pytest.mark.parametrize(
+    ("initial", "final", "levels"),
+    [((2), 9, [2, 3, 5, 9]), (9, 65, [9, 17, 33, 65]), (3, 9, [3, 5, 9]), (2, 2, [2]), (9, 9, [9]), (2, 3, [2, 3])],
+)
+def test_nested_bin_levels(initial, final, levels):
+    assert nested_bin_levels(initial, final) == levels
+
+
+@pytest.mark.parametrize(("initial", "final"), [(2, 8), (4, 9), (3, 8), (9, 64), (1, 9), (9, 2)])
+def test_nested_bin_levels_rejects_pairs_that_cannot_nest(initial, final):
+    with pytest.raises(ValueError):
+        nested_bin_levels(initial, final)
+
+
+def test_nested_bin_levels_rejects_non_integers():
+    with pytest.raises(TypeError):
+        nested_bin_levels(2.0, 9)
+
+
+def test_masks_of_the_2_to_9_levels():
+    # linspace(-1, 1, 9) = [-1, -.75, -.5, -.25, 0, .25, .5, .75, 1]
+    assert active_bin_indices(9, 2).tolist() == [0, 8]  # {-1, 1}
+    assert active_bin_indices(9, 3).tolist() == [0, 4, 8]  # {-1, 0, 1}
+    assert active_bin_indices(9, 5).tolist() == [0, 2, 4, 6, 8]
+    assert active_bin_indices(9, 9).tolist() == list(range(9))
+    assert active_bin_mask(9, 3).tolist() == [True, False, False, False, True, False, False, False, True]
+    # 9 -> 65: 17 active bins are every 4th of 65
+    assert active_bin_indices(65, 17).tolist() == list(range(0, 65, 4))
+
+
+def test_masked_bins_are_exactly_the_coarse_linspace():
+    grid = np.linspace(-2.0, 3.0, 65)
+    for level in (9, 17, 33, 65):
+        np.testing.assert_allclose(grid[active_bin_indices(65, level)], np.linspace(-2.0, 3.0, level))
+
+
+def test_masks_are_nested():
+    masks = [active_bin_mask(9, n) for n in nested_bin_levels(2, 9)]
+    for coarse, fine in itertools.pairwise(masks):
+        assert np.all(fine[coarse])
+
+
+def test_active_bin_indices_rejects_non_nested():
+    with pytest.raises(ValueError):
+        active_bin_indices(9, 4)
+
+
+def test_masked_argmax_and_max():
+    # two dims, 5 bins, active bins {0, 2, 4}
+    q = th.tensor([[[1.0, 9.0, 2.0, 8.0, 0.0], [-5.0, 7.0, -1.0, 7.0, -3.0]]])
+    mask = th.tensor([True, False, True, False, True])
+    assert masked_argmax(q, mask).tolist() == [[2, 2]]
+    assert masked_max(q, mask).tolist() == [[2.0, -1.0]]
+    # unmasked they would be 1 and 9
+    assert q.argmax(-1).tolist() == [[1, 1]]
+    all_on = th.ones(5, dtype=th.bool)
+    assert masked_argmax(q, all_on).tolist() == [[1, 1]]
+    assert masked_max(q, all_on).tolist() == [[9.0, 7.0]]
+
+
+def test_epsilon_greedy_stays_in_allowed_and_explores_at_rate():
+    rng = np.random.default_rng(0)
+    greedy = np.full((20_000, 3), 4)
+    allowed = np.array([0, 4, 8])
+    actions = epsilon_greedy(greedy, allowed, 0.3, rng=rng)
+    assert set(np.unique(actions)) <= {0, 4, 8}
+    # a dimension differs from greedy with prob 0.3 * 2/3 = 0.2, independently per dimension
+    changed = actions != greedy
+    assert changed.mean() == pytest.approx(0.2, abs=0.01)
+    assert changed.all(axis=1).mean() == pytest.approx(0.2**3, abs=0.004)
+
+
+def test_epsilon_greedy_respects_greedy_rows_and_zero_epsilon():
+    rng = np.random.default_rng(1)
+    greedy = np.zeros((4, 2), dtype=np.int64)
+    actions = epsilon_greedy(greedy, np.array([0, 8]), 1.0, rng=rng, greedy_rows=np.array([True, False, True, False]))
+    assert actions[[0, 2]].tolist() == [[0, 0], [0, 0]]
+    assert np.array_equal(epsilon_greedy(greedy, np.array([0, 8]), 0.0, rng=rng), greedy)
