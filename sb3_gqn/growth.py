@@ -129,12 +129,15 @@ class AdaptiveGrowth:
         if self.next_eval_step == 0:
             self.next_eval_step = self.eval_freq
 
-    def start(self, n_envs: int, env_was_reset: bool) -> None:
+    def start(self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0) -> None:
         """Prepare per-env bookkeeping at the start of ``learn()``.
 
         When the env was reset (new run, ``set_env``, load), the episodes in progress are gone: their
         partial returns are dropped and greedy evaluation episodes that were running are started again.
+        A run whose step counter was reset (``reset_num_timesteps=True``) evaluates ``eval_freq`` steps on.
         """
+        if self.next_eval_step > num_timesteps + self.eval_freq:
+            self.next_eval_step = num_timesteps + self.eval_freq
         if env_was_reset or len(self.greedy_envs) != n_envs:
             self.pending_episodes += int(self.greedy_envs.sum())
             self.greedy_envs = np.zeros(n_envs, dtype=bool)
@@ -207,7 +210,7 @@ class GrowthCallback(BaseCallback):
     def _on_training_start(self) -> None:
         schedule = self.model.growth_schedule
         if isinstance(schedule, AdaptiveGrowth):
-            schedule.start(self.model.n_envs, self.env_was_reset)
+            schedule.start(self.model.n_envs, self.env_was_reset, self.model.num_timesteps)
         self.model.logger.record("growth/active_bins", self.model.active_bins)
 
     def _on_step(self) -> bool:

@@ -46,13 +46,18 @@ def decoupled_action_shape(action_space: spaces.Space) -> tuple[int, int]:
 
 
 class DecoupledMLP(nn.Module):
-    """MLP torso: ``Linear -> [LayerNorm] -> activation`` blocks, optionally residual.
+    """MLP torso of the decoupled critic.
+
+    Plain: ``Linear -> activation`` per hidden layer. With ``layer_norm`` it is DecQN's torso (Acme's
+    ``LayerNormMLP``): the first layer is ``Linear -> LayerNorm -> tanh``, which keeps the features of
+    unnormalized observations in a fixed range, and the others ``Linear -> activation``. With
+    ``residual``, blocks whose input and output sizes match add their input to their output.
 
     :param input_dim: features dimension
     :param net_arch: hidden layer sizes
-    :param activation_fn: activation class
-    :param layer_norm: add a LayerNorm before each activation
-    :param residual: add the block input to its output where the sizes match
+    :param activation_fn: activation class of the hidden layers (after the first one with ``layer_norm``)
+    :param layer_norm: LayerNorm and tanh after the first layer
+    :param residual: residual connections between equal-size hidden blocks
     """
 
     def __init__(
@@ -67,12 +72,12 @@ class DecoupledMLP(nn.Module):
         self.blocks = nn.ModuleList()
         self.skips: list[bool] = []
         last_dim = input_dim
-        for size in net_arch:
-            layers: list[nn.Module] = [nn.Linear(last_dim, size)]
-            if layer_norm:
-                layers.append(nn.LayerNorm(size))
-            layers.append(activation_fn())
-            self.blocks.append(nn.Sequential(*layers))
+        for index, size in enumerate(net_arch):
+            if layer_norm and index == 0:
+                block = nn.Sequential(nn.Linear(last_dim, size), nn.LayerNorm(size), nn.Tanh())
+            else:
+                block = nn.Sequential(nn.Linear(last_dim, size), activation_fn())
+            self.blocks.append(block)
             self.skips.append(residual and size == last_dim)
             last_dim = size
         self.output_dim = last_dim

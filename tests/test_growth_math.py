@@ -65,3 +65,14 @@ def test_adaptive_rejects_bad_arguments():
         AdaptiveGrowth(returns_source="bogus")
     with pytest.raises(ValueError):
         AdaptiveGrowth(window=0)
+
+
+def test_adaptive_restarts_evaluation_clock_when_step_counter_resets():
+    schedule = AdaptiveGrowth(eval_freq=100)
+    schedule.start(n_envs=1, env_was_reset=True, num_timesteps=0)
+    schedule.observe(np.zeros(1), np.zeros(1, dtype=bool), 950)
+    assert schedule.next_eval_step == 1000
+    schedule.start(n_envs=1, env_was_reset=True, num_timesteps=0)  # learn(..., reset_num_timesteps=True)
+    assert schedule.next_eval_step == 100
+    schedule.start(n_envs=1, env_was_reset=False, num_timesteps=40)  # continuing keeps its clock
+    assert schedule.next_eval_step == 100
