@@ -18,12 +18,12 @@ from collections.abc import Callable
 
 os.environ.setdefault("MUJOCO_GL", "disable")
 
-import torch as th  # noqa: E402
-from stable_baselines3 import DQN, SAC  # noqa: E402
-from stable_baselines3.common.base_class import BaseAlgorithm  # noqa: E402
+import torch as th
+from stable_baselines3 import DQN, SAC
+from stable_baselines3.common.base_class import BaseAlgorithm
 
-from sb3_gqn import GQN  # noqa: E402
-from sb3_gqn.envs import make_env  # noqa: E402
+from sb3_gqn import GQN
+from sb3_gqn.envs import make_env
 
 
 def measure(make_model: Callable[[], BaseAlgorithm], steps: int, updates: int) -> dict[str, float]:
@@ -58,7 +58,9 @@ def main() -> None:
     for algo, env_id, make_model in cases:
         results[(algo, env_id)] = measure(make_model, args.steps, args.updates)
         figures = results[(algo, env_id)]
-        print(f"{algo:4s} {env_id:32s} {figures['steps_per_second']:8.1f} env steps/s {figures['ms_per_update']:7.2f} ms/update")
+        print(
+            f"{algo:4s} {env_id:32s} {figures['steps_per_second']:8.1f} env steps/s {figures['ms_per_update']:7.2f} ms/update"
+        )
 
     print("\nratios (GQN / baseline; steps/s higher is better, ms/update lower is better)")
     for baseline, env_id in (("SAC", "Pendulum-v1"), ("SAC", "dm_control/cartpole-swingup-v0"), ("DQN", "CartPole-v1")):
