@@ -1,6 +1,6 @@
 """The project's main job: train GQN on a penalized DeepMind Control task and write its results.
 
-    python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, 100k steps
+    python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, hyperparams/gqn.yml
     python -m sb3_gqn.reference_run --timesteps 20000 --out /tmp/smoke
 
 Writes to ``<out>/<run name>/``: ``learning_curve.csv`` (greedy evaluation every ``--eval-freq``
@@ -22,6 +22,7 @@ from typing import Any
 os.environ.setdefault("MUJOCO_GL", "disable")  # no rendering: keep dm_control off any GL backend
 
 import torch as th
+from stable_baselines3.common.logger import configure
 from stable_baselines3.common.monitor import Monitor
 
 from sb3_gqn import GQN, DecQN, __version__
@@ -36,7 +37,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--algo", choices=["gqn", "decqn"], default="gqn")
     parser.add_argument("--bins", type=int, nargs="+", default=[2, 9], help="initial and final bins (one int: static)")
     parser.add_argument("--growth", default="adaptive", choices=["adaptive", "linear", "none"])
-    parser.add_argument("--timesteps", type=int, default=100_000)
+    parser.add_argument("--timesteps", type=int, default=None, help="default: the env's n_timesteps in --hyperparams")
+    parser.add_argument(
+        "--hyperparams",
+        default=str(Path(__file__).resolve().parent.parent / "hyperparams" / "gqn.yml"),
+        help="rl-zoo3-style file whose entry for --env supplies GQN arguments (train_freq, bins, ...)",
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")
     parser.add_argument("--eval-episodes", type=int, default=5, help="episodes per learning-curve evaluation")
@@ -44,6 +50,23 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--out", default="results", help="output folder")
     parser.add_argument("--verbose", type=int, default=1)
     return parser.parse_args(argv)
+
+
+def load_hyperparams(path: str, env_id: str) -> dict[str, Any]:
+    """GQN constructor arguments of ``env_id``'s entry in an rl-zoo3-style YAML file ({} if absent)."""
+    if not Path(path).is_file():
+        return {}
+    import yaml
+
+    with open(path) as handle:
+        entry = dict((yaml.safe_load(handle) or {}).get(env_id, {}))
+    for key in ("policy", "env_wrapper", "normalize", "n_envs", "frame_stack", "bins", "growth"):
+        entry.pop(key, None)  # the env is built here; bins and growth come from the command line
+    if isinstance(entry.get("policy_kwargs"), str):
+        from torch import nn
+
+        entry["policy_kwargs"] = eval(entry["policy_kwargs"], {"dict": dict, "nn": nn})  # rl-zoo3's convention
+    return entry
 
 
 def run_name(args: argparse.Namespace) -> str:
@@ -80,7 +103,7 @@ def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str) -> N
     axis.set_ylabel("episode return (greedy)")
     axis.set_title(title, fontsize=9)
     axis.grid(alpha=0.3)
-    axis.legend(loc="lower right")
+    axis.legend(loc="upper left")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
     plt.close(figure)
@@ -88,19 +111,23 @@ def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str) -> N
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     args = parse_args(argv)
+    hyperparams = load_hyperparams(args.hyperparams, args.env)
+    n_timesteps = int(hyperparams.pop("n_timesteps", 100_000))
+    args.timesteps = args.timesteps or n_timesteps
     out = Path(args.out) / run_name(args)
     out.mkdir(parents=True, exist_ok=True)
     bins: int | tuple[int, int] = args.bins[0] if len(args.bins) == 1 else (args.bins[0], args.bins[1])
 
     env = Monitor(make_env(args.env, action_penalty=args.penalty))
     eval_env = Monitor(make_env(args.env, action_penalty=args.penalty))
-    common = dict(seed=args.seed, verbose=0)
+    common = dict(seed=args.seed, verbose=0, **hyperparams)
     if args.algo == "decqn":
         model: GQN = DecQN("MlpPolicy", env, bins=int(args.bins[-1]), **common)
     else:
         growth = None if args.growth == "none" else args.growth
         model = GQN("MlpPolicy", env, bins=bins, growth=growth, **common)
-    model.verbose = args.verbose  # growth events on the console, without SB3's per-episode tables
+    model.verbose = args.verbose  # growth events on the console
+    model.set_logger(configure(str(out), ["csv"]))  # SB3's training log to progress.csv instead of console tables
 
     curve = LearningCurveCallback(eval_env, eval_freq=args.eval_freq, n_episodes=args.eval_episodes, verbose=args.verbose)
     started = time.perf_counter()
@@ -114,6 +141,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     summary = {
         "run": run_name(args),
         "args": vars(args),
+        "hyperparams": {key: str(value) for key, value in hyperparams.items()},
         "timesteps": model.num_timesteps,
         "gradient_steps": model._n_updates,
         "wall_seconds": wall_seconds,
