@@ -209,24 +209,24 @@ class GQN(OffPolicyAlgorithm):
                 f"n_steps={self.n_steps} is not available for Dict observations: SB3's NStepReplayBuffer has no Dict "
                 "variant. Pass n_steps=1, or flatten the observations (gymnasium.wrappers.FlattenObservation)."
             )
-        with warnings.catch_warnings():
-            if self.replay_buffer_kwargs.get("n_steps") == self.n_steps:
-                # A loaded model already carries the NStepReplayBuffer SB3 chose for it: nothing is ignored.
-                warnings.filterwarnings("ignore", message=r"`n_steps=\d+` is ignored because a custom")
-            # The policy and the replay buffer work on bin indices; the env keeps its own action space.
-            check_action_space(self.action_space)
-            env_action_space = self.action_space
-            if isinstance(env_action_space, spaces.Box):
-                self.action_grid: BinGrid | None = BinGrid(env_action_space, self.bin_levels[-1])
-                self.discrete_action_space: spaces.Space = self.action_grid.discrete_space
-            else:
-                self.action_grid = None
-                self.discrete_action_space = env_action_space
-            self.action_space = self.discrete_action_space
-            try:
+        # The policy and the replay buffer work on bin indices; the env keeps its own action space.
+        check_action_space(self.action_space)
+        env_action_space = self.action_space
+        if isinstance(env_action_space, spaces.Box):
+            self.action_grid: BinGrid | None = BinGrid(env_action_space, self.bin_levels[-1])
+            self.discrete_action_space: spaces.Space = self.action_grid.discrete_space
+        else:
+            self.action_grid = None
+            self.discrete_action_space = env_action_space
+        self.action_space = self.discrete_action_space
+        try:
+            with warnings.catch_warnings():
+                if self.replay_buffer_kwargs.get("n_steps") == self.n_steps:
+                    # A loaded model already carries the NStepReplayBuffer SB3 chose for it: nothing is ignored.
+                    warnings.filterwarnings("ignore", message=r"`n_steps=\d+` is ignored because a custom")
                 super()._setup_model()
-            finally:
-                self.action_space = env_action_space
+        finally:
+            self.action_space = env_action_space
         self._create_aliases()
         if self.policy.max_bins != self.bin_levels[-1]:
             raise ValueError(
