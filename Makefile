@@ -29,6 +29,7 @@ test-slow: venv
 
 benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
+	$(BIN)/python benchmarks/replay.py
 
 # Re-pin the whole dependency set from a fresh environment
 constraints:

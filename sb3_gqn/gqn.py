@@ -7,7 +7,6 @@ from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 import torch as th
-import torch.nn.functional as F
 from gymnasium import spaces
 from stable_baselines3.common.buffers import ReplayBuffer
 from stable_baselines3.common.callbacks import BaseCallback, ConvertCallback
@@ -17,11 +16,12 @@ from stable_baselines3.common.policies import BasePolicy
 from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedule
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 
+from sb3_gqn.buffers import PrioritizedReplayBuffer
 from sb3_gqn.envs import check_action_space, resolve_env
 from sb3_gqn.growth import GROWTH_SCHEDULES, AdaptiveGrowth, GrowthCallback, nested_bin_levels
 from sb3_gqn.masking import active_bin_indices, active_bin_mask, epsilon_greedy
 from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
-from sb3_gqn.targets import decoupled_q_value, double_q_target
+from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
 from sb3_gqn.wrappers import BinGrid
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
@@ -68,8 +68,10 @@ class GQN(OffPolicyAlgorithm):
         32 samples per insert at batch 256.
     :param gradient_steps: How many gradient steps to do after each rollout (see ``train_freq``).
         Set to ``-1`` means to do as many gradient steps as steps done in the environment during the rollout.
-    :param replay_buffer_class: Replay buffer class to use. If ``None``, SB3 picks ``NStepReplayBuffer``
-        for ``n_steps > 1`` (``DictReplayBuffer`` for Dict observations, which requires ``n_steps=1``).
+    :param replay_buffer_class: Replay buffer class to use. If ``None``:
+        :class:`~sb3_gqn.buffers.PrioritizedReplayBuffer` with ``prioritized_replay=True``, otherwise SB3's
+        choice (``NStepReplayBuffer`` for ``n_steps > 1``, ``DictReplayBuffer`` for Dict observations,
+        which requires ``n_steps=1`` and ``prioritized_replay=False``).
     :param replay_buffer_kwargs: Keyword arguments to pass to the replay buffer on creation.
     :param optimize_memory_usage: Enable a memory efficient variant of the replay buffer (``n_steps=1`` only)
     :param n_steps: number of steps of the n-step return (SB3's ``NStepReplayBuffer``)
@@ -81,6 +83,13 @@ class GQN(OffPolicyAlgorithm):
     :param exploration_final_eps: final probability of a random bin per action dimension
         (DecQN and GQN use a constant 0.1)
     :param max_grad_norm: The maximum value for the gradient clipping (if None, no clipping)
+    :param prioritized_replay: sample transitions in proportion to ``(|td| + eps) ** priority_exponent``
+        (Schaul et al. 2016, n-step, :class:`~sb3_gqn.buffers.PrioritizedReplayBuffer`) and weight the loss
+        by importance-sampling weights; ``False`` gives SB3's uniform n-step buffer
+    :param priority_exponent: alpha, how strongly priorities shape sampling (0: uniform); DecQN: 0.6
+    :param importance_sampling_exponent: beta, how strongly the weights correct for it (1: fully); DecQN: 0.2
+    :param importance_sampling_annealing: anneal beta linearly from ``importance_sampling_exponent`` to 1
+        over ``total_timesteps`` (Schaul et al.) instead of keeping it constant (DecQN)
     :param bins: bins per action dimension: ``(initial, final)`` grows through the nested levels
         (``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and MultiDiscrete envs must
         have ``final`` choices per dimension.
@@ -137,6 +146,10 @@ class GQN(OffPolicyAlgorithm):
         exploration_initial_eps: float = 0.1,
         exploration_final_eps: float = 0.1,
         max_grad_norm: float | None = 40.0,
+        prioritized_replay: bool = True,
+        priority_exponent: float = 0.6,
+        importance_sampling_exponent: float = 0.2,
+        importance_sampling_annealing: bool = False,
         bins: int | tuple[int, int] = (2, 9),
         growth: str | None = "adaptive",
         growth_eval_freq: int = 5_000,
@@ -190,6 +203,10 @@ class GQN(OffPolicyAlgorithm):
         self.exploration_fraction = exploration_fraction
         self.exploration_rate = exploration_initial_eps
         self.max_grad_norm = max_grad_norm
+        self.prioritized_replay = prioritized_replay
+        self.priority_exponent = priority_exponent
+        self.importance_sampling_exponent = importance_sampling_exponent
+        self.importance_sampling_annealing = importance_sampling_annealing
         self.growth = growth
         self.growth_level = 0
         self.growth_schedule: AdaptiveGrowth | None = None
@@ -204,11 +221,7 @@ class GQN(OffPolicyAlgorithm):
             self._setup_model()
 
     def _setup_model(self) -> None:
-        if isinstance(self.observation_space, spaces.Dict) and self.replay_buffer_class is None and self.n_steps > 1:
-            raise ValueError(
-                f"n_steps={self.n_steps} is not available for Dict observations: SB3's NStepReplayBuffer has no Dict "
-                "variant. Pass n_steps=1, or flatten the observations (gymnasium.wrappers.FlattenObservation)."
-            )
+        self._setup_replay_buffer_class()
         # The policy and the replay buffer work on bin indices; the env keeps its own action space.
         check_action_space(self.action_space)
         env_action_space = self.action_space
@@ -243,6 +256,35 @@ class GQN(OffPolicyAlgorithm):
             self.exploration_initial_eps, self.exploration_final_eps, self.exploration_fraction
         )
         self._apply_growth_level()
+
+    def _setup_replay_buffer_class(self) -> None:
+        """Choose the prioritized n-step buffer by default; refuse combinations SB3 cannot serve."""
+        dict_observations = isinstance(self.observation_space, spaces.Dict)
+        if self.replay_buffer_class is None and dict_observations and (self.n_steps > 1 or self.prioritized_replay):
+            raise ValueError(
+                f"Dict observations need n_steps=1 and prioritized_replay=False (got n_steps={self.n_steps}, "
+                f"prioritized_replay={self.prioritized_replay}): SB3 has no n-step Dict buffer for them to build on. "
+                "Pass both, or flatten the observations (gymnasium.wrappers.FlattenObservation)."
+            )
+        if self.prioritized_replay:
+            if self.replay_buffer_class is None:
+                self.replay_buffer_class = PrioritizedReplayBuffer
+                self.replay_buffer_kwargs.update(
+                    n_steps=self.n_steps,
+                    gamma=self.gamma,
+                    alpha=self.priority_exponent,
+                    beta=self.importance_sampling_exponent,
+                )
+            elif not issubclass(self.replay_buffer_class, PrioritizedReplayBuffer):
+                raise ValueError(
+                    f"replay_buffer_class={self.replay_buffer_class.__name__} is not prioritized: pass "
+                    "prioritized_replay=False to train with it uniformly"
+                )
+        self.importance_sampling_schedule = LinearSchedule(
+            self.importance_sampling_exponent,
+            1.0 if self.importance_sampling_annealing else self.importance_sampling_exponent,
+            end_fraction=1.0,
+        )
 
     def _create_aliases(self) -> None:
         self.q_net = self.policy.q_net
@@ -361,6 +403,9 @@ class GQN(OffPolicyAlgorithm):
         # Update learning rate according to schedule
         self._update_learning_rate(self.policy.optimizer)
         active_bins_mask = self.policy.active_bins_mask
+        prioritized = isinstance(self.replay_buffer, PrioritizedReplayBuffer)
+        if prioritized:
+            self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)
 
         losses, q_values = [], []
         for _ in range(gradient_steps):
@@ -383,8 +428,10 @@ class GQN(OffPolicyAlgorithm):
             actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
             current = decoupled_q_value(self.q_net(replay_data.observations), actions)
 
-            # Eq. 1: Huber loss on the TD error
-            loss = F.huber_loss(current, target, reduction="mean")
+            # Eq. 1: Huber loss on the TD error, weighted by (N P(i))^-beta under prioritized replay
+            loss, abs_td_errors = huber_td_loss(current, target, replay_data.weights if prioritized else None)
+            if prioritized:  # the TD errors become the sampled transitions' new priorities
+                self.replay_buffer.update_priorities(replay_data.indices, abs_td_errors)  # type: ignore[union-attr]
             losses.append(loss.detach())
             q_values.append(current.detach().mean())
 
@@ -404,6 +451,9 @@ class GQN(OffPolicyAlgorithm):
         self.logger.record("train/loss", th.stack(losses).mean().item())
         self.logger.record("train/q_mean", th.stack(q_values).mean().item())
         self.logger.record("growth/active_bins", self.active_bins)
+        if prioritized:
+            self.logger.record("replay/importance_sampling_exponent", self.replay_buffer.beta)  # type: ignore[union-attr]
+            self.logger.record("replay/max_priority", self.replay_buffer.max_priority)  # type: ignore[union-attr]
 
     # ----------------------------------------------------------------------------------------------
     # SB3 hooks

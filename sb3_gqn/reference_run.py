@@ -1,6 +1,6 @@
 """The project's main job: train GQN on a penalized DeepMind Control task and write its results.
 
-    python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, hyperparams/gqn.yml
+    python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, sb3_gqn/hyperparams/gqn.yml
     python -m sb3_gqn.reference_run --timesteps 20000 --out /tmp/smoke
 
 Writes to ``<out>/<run name>/``: ``learning_curve.csv`` (greedy evaluation every ``--eval-freq``
@@ -28,6 +28,7 @@ from stable_baselines3.common.monitor import Monitor
 from sb3_gqn import GQN, DecQN, __version__
 from sb3_gqn.envs import make_env
 from sb3_gqn.evaluation import LearningCurveCallback, evaluate
+from sb3_gqn.zoo import HYPERPARAMS_DIR
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -40,7 +41,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--timesteps", type=int, default=None, help="default: the env's n_timesteps in --hyperparams")
     parser.add_argument(
         "--hyperparams",
-        default=str(Path(__file__).resolve().parent.parent / "hyperparams" / "gqn.yml"),
+        default=str(HYPERPARAMS_DIR / "gqn.yml"),
         help="rl-zoo3-style file whose entry for --env supplies GQN arguments (train_freq, bins, ...)",
     )
     parser.add_argument("--seed", type=int, default=0)

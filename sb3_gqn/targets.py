@@ -46,3 +46,23 @@ def double_q_target(
     if isinstance(discounts, th.Tensor):
         discounts = discounts.reshape(-1)
     return rewards.reshape(-1) + (1.0 - dones.reshape(-1)) * discounts * next_values
+
+
+def huber_td_loss(
+    current: th.Tensor,
+    target: th.Tensor,
+    weights: th.Tensor | None = None,
+) -> tuple[th.Tensor, th.Tensor]:
+    """Paper eq. 1's loss: the (importance-weighted) mean Huber loss of the TD errors ``y - Q(s, a)``.
+
+    :param current: ``Q(s_t, a_t)``, ``(batch,)``
+    :param target: ``y`` (no gradient), ``(batch,)``
+    :param weights: importance-sampling weights ``(batch,)`` or ``(batch, 1)`` from prioritized replay,
+        or ``None`` for a plain mean
+    :return: the scalar loss and the per-sample absolute TD errors ``|y - Q(s, a)|`` (detached), which
+        prioritized replay turns into new priorities
+    """
+    per_sample = th.nn.functional.huber_loss(current, target, reduction="none")
+    if weights is not None:
+        per_sample = per_sample * weights.reshape(-1)
+    return per_sample.mean(), (target - current).detach().abs()

@@ -177,16 +177,18 @@ def test_adaptive_growth_with_multiple_envs():
 
 
 def test_dict_observations_with_multi_input_policy():
-    model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, growth="linear", **SMALL)
+    model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, prioritized_replay=False, growth="linear", **SMALL)
     model.learn(300)
     assert model.active_bins == 9
     action, _ = model.predict({"state": np.zeros(3, np.float32), "time": np.zeros(1, np.float32)}, deterministic=True)
     assert action.shape == (2,) and set(action.tolist()) <= set(np.linspace(-1, 1, 9).tolist())
 
 
-def test_dict_observations_with_n_step_is_a_clear_error():
-    with pytest.raises(ValueError, match="n_steps"):
-        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=3, **SMALL)
+def test_dict_observations_with_n_step_or_prioritized_replay_is_a_clear_error():
+    with pytest.raises(ValueError, match="n_steps=1 and prioritized_replay=False"):
+        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=3, prioritized_replay=False, **SMALL)
+    with pytest.raises(ValueError, match="n_steps=1 and prioritized_replay=False"):
+        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, **SMALL)
 
 
 def test_discrete_env():

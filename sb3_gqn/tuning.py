@@ -1,0 +1,62 @@
+"""Optuna search spaces for GQN and DecQN in rl-zoo3's sampler / converter format.
+
+rl-zoo3 calls a sampler with an Optuna trial during ``-optimize`` and a converter with a stored trial's
+raw ``params`` for ``--trial-id``; both return GQN constructor arguments, and for any trial
+``convert(trial.params) == sample(trial)``. Raw values are plain numbers and strings so that every
+Optuna storage (SQLite, PostgreSQL) can hold them.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import optuna
+
+# Hidden layer widths per size name (DecQN uses 512x512)
+NET_ARCHS: dict[str, list[int]] = {"small": [256, 256], "medium": [512, 512], "large": [1024, 1024]}
+# Nested (initial, final) bin pairs; the strings are what the storage holds
+GQN_BINS = ("2-9", "3-9", "2-17", "9-65")
+DECQN_BINS = (2, 3, 5, 9)
+
+
+def _sample_common(trial: optuna.Trial) -> None:
+    trial.suggest_float("learning_rate", 1e-5, 1e-3, log=True)
+    trial.suggest_categorical("batch_size", [64, 128, 256, 512])
+    trial.suggest_int("n_steps", 1, 5)
+    trial.suggest_categorical("target_update_interval", [25, 50, 100, 250, 500, 1000])
+    trial.suggest_categorical("train_freq", [1, 2, 4, 8])
+    trial.suggest_categorical("net_arch", list(NET_ARCHS))
+    trial.suggest_float("epsilon", 0.01, 0.3, log=True)
+
+
+def sample_gqn_params(
+    trial: optuna.Trial, n_actions: int = 0, n_envs: int = 1, additional_args: dict | None = None
+) -> dict[str, Any]:
+    """GQN search space: learning rate, batch size, n-step, target update interval, train frequency,
+    network size, epsilon, bins pair and growth schedule (rl-zoo3 sampler signature)."""
+    _sample_common(trial)
+    trial.suggest_categorical("bins", list(GQN_BINS))
+    trial.suggest_categorical("growth", ["adaptive", "linear"])
+    return convert_gqn_params(trial.params)
+
+
+def sample_decqn_params(
+    trial: optuna.Trial, n_actions: int = 0, n_envs: int = 1, additional_args: dict | None = None
+) -> dict[str, Any]:
+    """DecQN search space: as GQN's, with a static number of bins instead of a pair and no growth."""
+    _sample_common(trial)
+    trial.suggest_categorical("bins", list(DECQN_BINS))
+    return convert_gqn_params(trial.params)
+
+
+def convert_gqn_params(params: dict[str, Any]) -> dict[str, Any]:
+    """Raw trial values -> GQN/DecQN constructor arguments (rl-zoo3 converter signature)."""
+    hyperparams = dict(params)
+    epsilon = hyperparams.pop("epsilon")
+    hyperparams["exploration_initial_eps"] = epsilon
+    hyperparams["exploration_final_eps"] = epsilon
+    hyperparams["policy_kwargs"] = dict(net_arch=NET_ARCHS[hyperparams.pop("net_arch")])
+    if isinstance(hyperparams["bins"], str):
+        initial, final = hyperparams["bins"].split("-")
+        hyperparams["bins"] = (int(initial), int(final))
+    return hyperparams
