@@ -221,6 +221,10 @@ class GQN(OffPolicyAlgorithm):
             self._setup_model()
 
     def _setup_model(self) -> None:
+        # Recomputed here too: load() may pass a new ``bins`` (rl-zoo3's ``-i`` passes the file's hyperparameters)
+        self.bin_levels = bin_levels_from(self.bins)
+        if not 0 <= self.growth_level < len(self.bin_levels):
+            raise ValueError(f"Growth level {self.growth_level} does not exist for bins={self.bins} ({self.bin_levels})")
         self._setup_replay_buffer_class()
         # The policy and the replay buffer work on bin indices; the env keeps its own action space.
         check_action_space(self.action_space)

@@ -112,3 +112,12 @@ def test_grow_backwards_or_past_the_end():
         model.grow(1)
     with pytest.raises(ValueError, match="Cannot grow"):
         model.grow()
+
+
+def test_load_with_bins_that_do_not_hold_the_saved_level(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, policy_kwargs=dict(net_arch=[8]))
+    model.grow(3)
+    model.save(tmp_path / "model")
+    with pytest.raises(ValueError, match="Growth level 3 does not exist"):
+        GQN.load(tmp_path / "model", bins=(5, 9))
+    assert GQN.load(tmp_path / "model", bins=[2, 9]).active_bins == 9

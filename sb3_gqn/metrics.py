@@ -1,0 +1,132 @@
+"""Control smoothness figures of the paper's figure 4 for rollouts of any SB3 model (GQN, SAC, ...)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+
+def smoothness(actions: np.ndarray, freq: float) -> float:
+    """FFT smoothness SM of Mysore et al. 2021 (CAPS): ``SM = 2 / (n * f_s) * sum_i M_i f_i``.
+
+    For each action dimension, ``M_i`` is the amplitude ``2 |FFT(a)_i| / N`` of frequency
+    ``f_i = i * f_s / N`` over the ``n = N // 2`` one-sided bins ``i = 0 .. n - 1`` of a signal of ``N``
+    samples; SM is the mean over dimensions. Lower is smoother: a constant signal has SM = 0 and a
+    sinusoid of amplitude ``A`` at a bin frequency ``f`` has ``SM = 2 A f / (n f_s)``.
+
+    :param actions: ``(T,)`` or ``(T, M)`` actions sampled at ``freq`` Hz, ``T >= 2``; use actions
+        rescaled to ``[-1, 1]`` to compare agents and envs
+    :param freq: sampling frequency ``f_s`` in Hz: the env's control frequency (see
+        :func:`control_frequency`), or 1 to measure frequencies in cycles per step
+    """
+    actions = np.asarray(actions, dtype=np.float64)
+    if actions.ndim == 1:
+        actions = actions[:, None]
+    if actions.ndim != 2 or actions.shape[0] < 2:
+        raise ValueError(f"actions must be (T,) or (T, M) with T >= 2 samples, got shape {actions.shape}")
+    if not np.all(np.isfinite(actions)):
+        raise ValueError("actions contain NaN or infinite values")
+    if not freq > 0:
+        raise ValueError(f"freq must be a positive sampling frequency in Hz, got {freq}")
+    n_samples = actions.shape[0]
+    n_bins = n_samples // 2
+    amplitudes = 2.0 / n_samples * np.abs(np.fft.rfft(actions, axis=0)[:n_bins])  # (n, M)
+    frequencies = np.arange(n_bins) * freq / n_samples  # (n,)
+    per_dimension = 2.0 / (n_bins * freq) * (amplitudes * frequencies[:, None]).sum(axis=0)
+    return float(per_dimension.mean())
+
+
+def control_frequency(env: gym.Env) -> float | None:
+    """The env's control frequency in Hz (1 / control timestep), or ``None`` if it does not say.
+
+    Read from ``unwrapped.dt`` (Gymnasium classic control and MuJoCo envs, Meta-World) or from the
+    wrapped dm_control env's ``control_timestep()`` (shimmy).
+    """
+    unwrapped = env.unwrapped
+    timestep = getattr(unwrapped, "dt", None)
+    if timestep is None and hasattr(getattr(unwrapped, "_env", None), "control_timestep"):
+        timestep = unwrapped._env.control_timestep()  # shimmy's DmControlCompatibilityV0
+    try:
+        return 1.0 / float(timestep) if timestep else None
+    except (TypeError, ValueError):
+        return None
+
+
+def normalized_actions(actions: np.ndarray, action_space: spaces.Box) -> np.ndarray:
+    """Actions rescaled from ``[low, high]`` to ``[-1, 1]`` per dimension."""
+    low, high = action_space.low.astype(np.float64), action_space.high.astype(np.float64)
+    return 2.0 * (np.asarray(actions, dtype=np.float64) - low) / (high - low) - 1.0
+
+
+@dataclass
+class SmoothnessFigures:
+    """Figure 4's metrics for greedy rollouts, each the mean over episodes.
+
+    ``task_return`` R (without the action penalty), ``penalty`` P (the action cost ``sum_t sum_j a_j^2``
+    of the rescaled actions, i.e. the penalty with ``c = 1``; the reward lost to an ``ActionPenalty(c)``
+    is ``c * P``), ``action_magnitude`` |a| (mean of ``|a_j|``), ``action_change`` |Δa| (mean of
+    ``|a_j(t) - a_j(t-1)|``), ``smoothness`` SM (:func:`smoothness` per episode), ``return_`` the
+    return the agent was trained on (penalized if the env is), and the sampling frequency used.
+    """
+
+    task_return: float
+    penalty: float
+    action_magnitude: float
+    action_change: float
+    smoothness: float
+    return_: float
+    episode_length: float
+    freq: float
+    episodes: int
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def rollout_figures(
+    model: Any,
+    env: gym.Env,
+    n_episodes: int = 5,
+    deterministic: bool = True,
+    freq: float | None = None,
+    seed: int | None = None,
+) -> SmoothnessFigures:
+    """Run ``model`` (anything with SB3's ``predict``) greedily for ``n_episodes`` on a single
+    (non-vectorized) ``env`` with a ``Box`` action space and compute :class:`SmoothnessFigures`.
+
+    :param freq: sampling frequency for SM; default :func:`control_frequency` of ``env``, else 1
+        (SM then counts cycles per step)
+    :param seed: seed of the first episode's reset (episode k uses ``seed + k``)
+    """
+    if not isinstance(env.action_space, spaces.Box):
+        raise TypeError(f"Smoothness figures need a Box action space, got {env.action_space}")
+    freq = freq or control_frequency(env) or 1.0
+    per_episode: list[list[float]] = []
+    for episode in range(n_episodes):
+        observation, _ = env.reset(seed=None if seed is None else seed + episode)
+        actions, task_return, total_return, done = [], 0.0, 0.0, False
+        while not done:
+            action, _ = model.predict(observation, deterministic=deterministic)
+            observation, reward, terminated, truncated, info = env.step(action)
+            actions.append(np.asarray(action, dtype=np.float64).reshape(-1))
+            total_return += float(reward)
+            task_return += float(info.get("task_reward", reward))
+            done = terminated or truncated
+        scaled = normalized_actions(np.stack(actions), env.action_space)
+        per_episode.append(
+            [
+                task_return,
+                float((scaled**2).sum()),
+                float(np.abs(scaled).mean()),
+                float(np.abs(np.diff(scaled, axis=0)).mean()) if len(scaled) > 1 else 0.0,
+                smoothness(scaled, freq) if len(scaled) > 1 else 0.0,
+                total_return,
+                float(len(scaled)),
+            ]
+        )
+    means = np.mean(per_episode, axis=0)
+    return SmoothnessFigures(*map(float, means), freq=float(freq), episodes=n_episodes)
