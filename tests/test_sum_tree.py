@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -94,11 +96,17 @@ def test_sampling_an_empty_tree_is_an_error():
         SumTree(3).sample(4)
 
 
-@settings(max_examples=150, deadline=None)
+# Priorities are (|td| + eps) ** alpha >= eps ** alpha, never subnormal: subnormal totals make the probe grid itself
+# round onto the upper bound. derandomize keeps CI deterministic; set HYPOTHESIS_EXAMPLES=3000 locally to search further.
+@settings(max_examples=int(os.environ.get("HYPOTHESIS_EXAMPLES", 150)), deadline=None, derandomize=True)
 @given(
     capacity=st.integers(1, 70),
     updates=st.lists(
-        st.lists(st.tuples(st.integers(0, 10_000), st.floats(0.0, 1e6, allow_nan=False)), min_size=1, max_size=40),
+        st.lists(
+            st.tuples(st.integers(0, 10_000), st.floats(0.0, 1e6, allow_nan=False, allow_subnormal=False)),
+            min_size=1,
+            max_size=40,
+        ),
         min_size=1,
         max_size=15,
     ),

@@ -1,0 +1,334 @@
+"""Comparison suite: GQN vs DecQN vs SAC/TD3 on penalized envs, in parallel, resumable, one tidy table and plots.
+
+    python -m sb3_gqn.benchmark                       # short suite: Pendulum-v1, c = 0.1 (~10 min on 2 cores)
+    python -m sb3_gqn.benchmark --algos gqn-adaptive sac --envs dm_control/cartpole-swingup-v0 \\
+        --penalties 0.1 --seeds 0 1 --steps 100000 --out results/cartpole
+    python -m sb3_gqn.benchmark --full --list         # the paper-scale suite (list the runs only)
+
+Each run trains through the project's rl-zoo3 integration (``ExperimentManager`` with the shipped
+hyperparameter file of its algorithm, the penalty set in the entry's ``ActionPenalty`` wrapper and the
+budget given here), evaluates greedily every ``--eval-freq`` steps with :func:`~sb3_gqn.metrics.rollout_figures`
+and writes ``<out>/runs/<run>/curve.csv``; ``done.json`` marks it finished. Runs go to parallel
+processes (``--jobs``, default the core count, torch threads split between them). A second invocation
+skips finished runs and restarts interrupted ones from scratch. At the end ``<out>/results.csv`` holds
+every evaluation of every run of the suite (algo, env, penalty, seed, step, return, task return, wall
+time, smoothness figures) and :mod:`sb3_gqn.plots` draws the figures into ``<out>/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import shutil
+import sys
+import time
+from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoCo off any GL backend
+
+import gymnasium as gym
+from stable_baselines3.common.callbacks import BaseCallback
+
+from sb3_gqn.metrics import rollout_figures
+
+#: Algorithm variants: (rl-zoo3 algorithm, hyperparameter overrides on its shipped file)
+VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    "gqn-adaptive": ("gqn", {"growth": "adaptive"}),
+    "gqn-linear": ("gqn", {"growth": "linear"}),
+    "decqn-2": ("decqn", {"bins": 2}),
+    "decqn-9": ("decqn", {"bins": 9}),
+    "sac": ("sac", {}),
+    "td3": ("td3", {}),
+}
+SHORT_SUITE = dict(
+    algos=["gqn-linear", "decqn-2", "decqn-9", "sac"], envs=["Pendulum-v1"], penalties=[0.1], seeds=[0], steps=10_000
+)
+FULL_SUITE = dict(
+    algos=list(VARIANTS),
+    envs=[
+        "dm_control/cartpole-swingup-v0",
+        "dm_control/reacher-easy-v0",
+        "dm_control/finger-spin-v0",
+        "dm_control/walker-walk-v0",
+        "dm_control/cheetah-run-v0",
+        "dm_control/humanoid-walk-v0",
+        "sb3_gqn/metaworld-reach-v3",
+    ],
+    penalties=[0.0, 0.1, 0.5],
+    seeds=[0, 1, 2, 3],
+    steps=1_000_000,
+)
+#: Columns of results.csv, in order
+COLUMNS = [
+    "algo",
+    "env",
+    "penalty",
+    "seed",
+    "step",
+    "return",
+    "task_return",
+    "action_penalty",
+    "action_magnitude",
+    "action_change",
+    "smoothness",
+    "smoothness_freq",
+    "episode_length",
+    "active_bins",
+    "wall_time",
+]
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One training run of the suite."""
+
+    algo: str
+    env: str
+    penalty: float
+    seed: int
+    steps: int
+
+    @property
+    def name(self) -> str:
+        return f"{self.algo}__{self.env.replace('/', '-')}__c{self.penalty:g}__seed{self.seed}"
+
+
+def penalized_wrappers(env_wrapper: Any, penalty: float) -> list[Any]:
+    """The entry's ``env_wrapper`` list with the ``ActionPenalty`` coefficient set to ``penalty``."""
+    wrappers = [] if env_wrapper is None else list(env_wrapper if isinstance(env_wrapper, list) else [env_wrapper])
+    name = "sb3_gqn.wrappers.ActionPenalty"
+    kept = [w for w in wrappers if not (w == name or (isinstance(w, dict) and name in w))]
+    return [*kept, {name: {"coef": float(penalty)}}]
+
+
+def _shipped_entry(zoo_algo: str, env_id: str) -> dict[str, Any]:
+    import yaml
+
+    from sb3_gqn.zoo import shipped_hyperparams
+
+    path = shipped_hyperparams(zoo_algo)
+    with open(path) as handle:  # type: ignore[arg-type]
+        entries = yaml.safe_load(handle)
+    if env_id not in entries:
+        raise ValueError(f"{path} has no entry for {env_id!r} (entries: {', '.join(entries)})")
+    return entries[env_id]
+
+
+class BenchmarkCallback(BaseCallback):
+    """Evaluates greedily every ``eval_freq`` steps and at the end; appends a row per evaluation to ``curve.csv``.
+
+    ``wall_time`` counts training only (evaluations excluded).
+    """
+
+    def __init__(self, spec: RunSpec, run_dir: Path, eval_env: gym.Env, eval_freq: int, n_episodes: int):
+        super().__init__()
+        self.spec, self.run_dir, self.eval_env = spec, run_dir, eval_env
+        self.eval_freq, self.n_episodes = eval_freq, n_episodes
+        self.train_seconds, self.last_eval, self.started = 0.0, 0, 0.0
+
+    def _on_training_start(self) -> None:
+        self.started = time.perf_counter()
+
+    def evaluate(self) -> None:
+        self.train_seconds += time.perf_counter() - self.started
+        figures = rollout_figures(self.model, self.eval_env, self.n_episodes, seed=10_000 + self.spec.seed)
+        row = {
+            "algo": self.spec.algo,
+            "env": self.spec.env,
+            "penalty": self.spec.penalty,
+            "seed": self.spec.seed,
+            "step": self.num_timesteps,
+            "return": figures.return_,
+            "task_return": figures.task_return,
+            "action_penalty": figures.penalty,
+            "action_magnitude": figures.action_magnitude,
+            "action_change": figures.action_change,
+            "smoothness": figures.smoothness,
+            "smoothness_freq": figures.freq,
+            "episode_length": figures.episode_length,
+            "active_bins": getattr(self.model, "active_bins", ""),
+            "wall_time": round(self.train_seconds, 2),
+        }
+        with open(self.run_dir / "curve.csv", "a", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+            if handle.tell() == 0:
+                writer.writeheader()
+            writer.writerow(row)
+        self.last_eval = self.num_timesteps
+        self.started = time.perf_counter()
+
+    def _on_step(self) -> bool:
+        if self.num_timesteps - self.last_eval >= self.eval_freq:
+            self.evaluate()
+        if self.n_calls % 500 == 0:
+            (self.run_dir / "progress").write_text(str(self.num_timesteps))
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.num_timesteps > self.last_eval:
+            self.evaluate()
+
+
+def run(spec: RunSpec, out: Path, eval_freq: int, eval_episodes: int, threads: int) -> str:
+    """Train and evaluate one run in this process; return its name. Skips a finished run."""
+    run_dir = out / "runs" / spec.name
+    if (run_dir / "done.json").is_file():
+        return spec.name
+    if run_dir.exists():  # interrupted earlier: start again from scratch
+        shutil.rmtree(run_dir)
+    run_dir.mkdir(parents=True)
+    import torch as th
+    from rl_zoo3.exp_manager import ExperimentManager
+    from rl_zoo3.utils import get_wrapper_class
+
+    from sb3_gqn.plots import save_q_snapshot
+    from sb3_gqn.zoo import register, shipped_hyperparams
+
+    th.set_num_threads(threads)
+    register()
+    zoo_algo, overrides = VARIANTS[spec.algo]
+    entry = _shipped_entry(zoo_algo, spec.env)
+    wrappers = penalized_wrappers(entry.get("env_wrapper"), spec.penalty)
+    manager = ExperimentManager(
+        argparse.Namespace(),
+        zoo_algo,
+        spec.env,
+        str(run_dir / "zoo"),
+        n_timesteps=spec.steps,
+        eval_freq=-1,
+        hyperparams={**overrides, "env_wrapper": wrappers},
+        seed=spec.seed,
+        verbose=0,
+        log_interval=-1,
+        config=str(shipped_hyperparams(zoo_algo)),
+    )
+    model, _ = manager.setup_experiment()  # type: ignore[misc]
+    wrapper = get_wrapper_class({"env_wrapper": wrappers})
+    eval_env = gym.make(spec.env)
+    eval_env = wrapper(eval_env) if wrapper is not None else eval_env
+    manager.callbacks.append(BenchmarkCallback(spec, run_dir, eval_env, eval_freq, eval_episodes))
+    if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
+        manager.callbacks.append(save_q_snapshot(run_dir))
+    started = time.perf_counter()
+    manager.learn(model)
+    model.save(run_dir / "model.zip")
+    summary = {"run": spec.name, "spec": spec.__dict__, "wall_seconds": time.perf_counter() - started, "threads": threads}
+    (run_dir / "done.json.tmp").write_text(json.dumps(summary, indent=2))
+    os.replace(run_dir / "done.json.tmp", run_dir / "done.json")
+    return spec.name
+
+
+def collect(specs: list[RunSpec], out: Path) -> Path:
+    """Concatenate the suite's finished curves into ``<out>/results.csv``."""
+    table = out / "results.csv"
+    with open(table, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+        writer.writeheader()
+        for spec in specs:
+            curve = out / "runs" / spec.name / "curve.csv"
+            if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
+                with open(curve, newline="") as rows:
+                    writer.writerows(csv.DictReader(rows))
+    return table
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--algos", nargs="+", choices=list(VARIANTS), help=f"default: {SHORT_SUITE['algos']}")
+    parser.add_argument("--envs", nargs="+", help=f"env ids with an entry in the shipped files; default {SHORT_SUITE['envs']}")
+    parser.add_argument("--penalties", nargs="+", type=float, help="action penalty coefficients c")
+    parser.add_argument("--seeds", nargs="+", type=int)
+    parser.add_argument("--steps", type=int, help="env steps per run (the same for every algorithm)")
+    parser.add_argument("--full", action="store_true", help="paper-scale defaults (many machine-days)")
+    parser.add_argument("--eval-freq", type=int, help="env steps between evaluations (default: steps / 10)")
+    parser.add_argument("--eval-episodes", type=int, default=3, help="greedy episodes per evaluation")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
+    parser.add_argument("--out", default="results/benchmark", help="output folder")
+    parser.add_argument("--list", action="store_true", help="list the runs and their state, train nothing")
+    parser.add_argument("--no-plots", action="store_true")
+    args = parser.parse_args(argv)
+    defaults = FULL_SUITE if args.full else SHORT_SUITE
+    for key in ("algos", "envs", "penalties", "seeds", "steps"):
+        if getattr(args, key) is None:
+            setattr(args, key, defaults[key])
+    if args.eval_freq is None:
+        args.eval_freq = max(args.steps // 10, 1)
+    return args
+
+
+def _report(specs: list[RunSpec], out: Path, running: dict[str, RunSpec]) -> str:
+    done = sum((out / "runs" / spec.name / "done.json").is_file() for spec in specs)
+    parts = [f"[{done}/{len(specs)} runs done]"]
+    for name, spec in running.items():
+        progress = out / "runs" / name / "progress"
+        steps = progress.read_text() if progress.is_file() else "0"
+        parts.append(f"{name}: {steps}/{spec.steps} steps")
+    return "  ".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    unknown = [env for env in args.envs if env not in _known_envs()]
+    if unknown:
+        print(f"sb3_gqn.benchmark: error: no hyperparameter entry for {unknown} (known: {_known_envs()})", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    specs = [
+        RunSpec(algo, env, penalty, seed, args.steps)
+        for env in args.envs
+        for penalty in args.penalties
+        for algo in args.algos
+        for seed in args.seeds
+    ]
+    pending = [spec for spec in specs if not (out / "runs" / spec.name / "done.json").is_file()]
+    print(f"{len(specs)} runs, {len(specs) - len(pending)} already finished, {len(pending)} to train -> {out}")
+    if args.list:
+        for spec in specs:
+            print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
+        return 0
+    jobs = max(1, min(args.jobs, len(pending) or 1))
+    threads = max(1, (os.cpu_count() or 1) // jobs)
+    if pending:
+        out.mkdir(parents=True, exist_ok=True)
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+            futures: dict[Future, RunSpec] = {
+                pool.submit(run, spec, out, args.eval_freq, args.eval_episodes, threads): spec for spec in pending
+            }
+            last_report = 0.0
+            while futures:
+                for future in [future for future in futures if future.done()]:
+                    spec = futures.pop(future)
+                    future.result()  # a failed run stops the suite with its error
+                    print(f"finished {spec.name}")
+                if time.monotonic() - last_report > 15:
+                    running = {spec.name: spec for spec in futures.values() if (out / "runs" / spec.name).exists()}
+                    print(_report(specs, out, running), flush=True)
+                    last_report = time.monotonic()
+                time.sleep(0.5)
+    table = collect(specs, out)
+    print(f"results table: {table}")
+    if not args.no_plots:
+        from sb3_gqn.plots import plot_suite
+
+        for path in plot_suite(table, out):
+            print(f"plot: {path}")
+    return 0
+
+
+def _known_envs() -> list[str]:
+    import yaml
+
+    from sb3_gqn.zoo import HYPERPARAMS_DIR
+
+    with open(HYPERPARAMS_DIR / "gqn.yml") as handle:
+        return list(yaml.safe_load(handle))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,219 @@
+"""Figures of the comparison suite (paper figures 2-4) from ``results.csv`` and the runs' Q-value snapshots."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+import torch as th
+from stable_baselines3.common.callbacks import BaseCallback
+
+#: Figure 4's axes: column of results.csv -> label
+RADAR_METRICS = {
+    "task_return": "R",
+    "action_penalty": "P",
+    "action_magnitude": "|a|",
+    "action_change": "|Δa|",
+    "smoothness": "SM",
+}
+# Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
+PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
+PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
+
+
+def _slug(text: str) -> str:
+    return text.replace("/", "-").replace(" ", "_")
+
+
+class QValueSnapshots(BaseCallback):
+    """Saves GQN's per-bin utilities over Pendulum's (angle, velocity) grid at the end of every growth level.
+
+    ``q_level<g>.npz`` holds ``utilities`` ``(angles, velocities, max_bins)``, the level's active bins and the grid.
+    """
+
+    def __init__(self, run_dir: Path):
+        super().__init__()
+        self.run_dir = Path(run_dir)
+        self.level = 0
+
+    def _snapshot(self, level: int) -> None:
+        angle, velocity = np.meshgrid(PENDULUM_ANGLES, PENDULUM_VELOCITIES, indexing="ij")
+        observations = np.stack([np.cos(angle), np.sin(angle), velocity], axis=-1).reshape(-1, 3).astype(np.float32)
+        with th.no_grad():
+            utilities = self.model.q_net(th.as_tensor(observations, device=self.model.device))  # type: ignore[attr-defined]
+        utilities = utilities[:, 0, :].cpu().numpy().reshape(len(PENDULUM_ANGLES), len(PENDULUM_VELOCITIES), -1)
+        np.savez(
+            self.run_dir / f"q_level{level}.npz",
+            utilities=utilities,
+            active_bins=self.model.bin_levels[level],  # type: ignore[attr-defined]
+            max_bins=self.model.bin_levels[-1],  # type: ignore[attr-defined]
+            angles=PENDULUM_ANGLES,
+            velocities=PENDULUM_VELOCITIES,
+            step=self.num_timesteps,
+        )
+
+    def _on_step(self) -> bool:
+        level = self.model.growth_level  # type: ignore[attr-defined]
+        if level != self.level:  # the network as it was trained at the previous level
+            self._snapshot(self.level)
+            self.level = level
+        return True
+
+    def _on_training_end(self) -> None:
+        self._snapshot(self.model.growth_level)  # type: ignore[attr-defined]
+
+
+def save_q_snapshot(run_dir: Path) -> QValueSnapshots:
+    return QValueSnapshots(run_dir)
+
+
+def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
+    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band."""
+    paths = []
+    for (env, penalty), task in table.groupby(["env", "penalty"]):
+        figure, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for algo, runs in task.groupby("algo"):
+            curve = runs.groupby("step").agg(
+                mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "mean")
+            )
+            half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
+            for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
+                axis.plot(x, curve["mean"], label=f"{algo} ({int(curve['count'].max())} seeds)")
+                axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2)
+        axes[0].set_xlabel("environment steps")
+        axes[1].set_xlabel("training wall time [s]")
+        axes[0].set_ylabel("greedy return (penalized)")
+        axes[0].legend(fontsize=8)
+        figure.suptitle(f"{env}, action penalty c = {penalty:g} (mean, 95 % CI over seeds)")
+        figure.tight_layout()
+        path = out / f"learning_curves_{_slug(env)}_c{penalty:g}.png"
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        paths.append(path)
+    return paths
+
+
+def final_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """The last evaluation of every run."""
+    last = table.groupby(["algo", "env", "penalty", "seed"])["step"].transform("max")
+    return table[table["step"] == last]
+
+
+def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
+    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs."""
+    from rliable import library as rly
+    from rliable import metrics as rly_metrics
+
+    final = final_rows(table).copy()
+    task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
+    final = final.join(task_range, on=["env", "penalty"])
+    spread = (final["max"] - final["min"]).replace(0.0, 1.0)
+    final["normalized"] = (final["return"] - final["min"]) / spread
+    tasks = sorted(set(zip(final["env"], final["penalty"])))
+    scores: dict[str, np.ndarray] = {}
+    for algo, runs in final.groupby("algo"):
+        per_task = [runs[(runs["env"] == env) & (runs["penalty"] == c)]["normalized"].to_numpy() for env, c in tasks]
+        n_runs = min(len(values) for values in per_task)
+        if n_runs:
+            scores[str(algo)] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
+    estimates, intervals = rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
+    algos = sorted(scores, key=lambda algo: estimates[algo][0])
+    figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
+    for row, algo in enumerate(algos):
+        low, high = intervals[algo][:, 0]
+        axis.barh(row, high - low, left=low, height=0.6, alpha=0.6)
+        axis.plot([estimates[algo][0]] * 2, [row - 0.3, row + 0.3], color="black")
+    axis.set_yticks(range(len(algos)), algos)
+    axis.set_xlabel("IQM of normalized final return (95 % bootstrap CI)")
+    axis.set_title(f"{len(tasks)} task(s): " + ", ".join(f"{env} c={c:g}" for env, c in tasks), fontsize=8)
+    figure.tight_layout()
+    path = out / "aggregate_iqm.png"
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+    return path
+
+
+def _reference(final: pd.DataFrame) -> tuple[str, float] | None:
+    """Figure 4's reference: GQN without penalty (adaptive, else linear), else at the smallest penalty run."""
+    for algo in ("gqn-adaptive", "gqn-linear", *sorted(final["algo"].unique())):
+        runs = final[final["algo"] == algo]
+        if len(runs):
+            return algo, float(runs["penalty"].min())
+    return None
+
+
+def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
+    """Figure 4 per env: R, P, |a|, |Δa|, SM of the final policies relative to the reference agent."""
+    paths = []
+    for env, runs in final_rows(table).groupby("env"):
+        reference = _reference(runs)
+        if reference is None:
+            continue
+        means = runs.groupby(["algo", "penalty"])[list(RADAR_METRICS)].mean()
+        base = means.loc[reference].replace(0.0, np.nan)
+        angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
+        figure, axis = plt.subplots(figsize=(5.5, 5.5), subplot_kw={"projection": "polar"})
+        for (algo, penalty), values in means.iterrows():
+            relative = (values / base).abs().fillna(0.0).to_numpy()
+            closed = np.append(relative, relative[0])
+            axis.plot(np.append(angles, angles[0]), closed, label=f"{algo} c={penalty:g}")
+        axis.set_xticks(angles, list(RADAR_METRICS.values()))
+        axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g}", fontsize=9)
+        axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
+        figure.tight_layout()
+        path = out / f"smoothness_radar_{_slug(env)}.png"
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        paths.append(path)
+    return paths
+
+
+def q_value_picture(run_dir: Path, out: Path) -> Path | None:
+    """Figure 2: per-bin utilities over Pendulum's (angle, velocity) grid at each growth level, active bins outlined."""
+    snapshots = sorted(run_dir.glob("q_level*.npz"), key=lambda path: int(path.stem.removeprefix("q_level")))
+    if not snapshots:
+        return None
+    loaded: list[Any] = [np.load(path) for path in snapshots]
+    max_bins = int(loaded[0]["max_bins"])
+    figure, axes = plt.subplots(len(loaded), max_bins, figsize=(1.3 * max_bins, 1.4 * len(loaded)), squeeze=False)
+    for row, snapshot in enumerate(loaded):
+        utilities, active = snapshot["utilities"], int(snapshot["active_bins"])
+        active_indices = set(np.linspace(0, max_bins - 1, active).round().astype(int).tolist())
+        low, high = np.percentile(utilities, [2, 98])
+        extent = (snapshot["velocities"][0], snapshot["velocities"][-1], snapshot["angles"][0], snapshot["angles"][-1])
+        for column in range(max_bins):
+            axis = axes[row, column]
+            axis.imshow(utilities[:, :, column], origin="lower", aspect="auto", extent=extent, vmin=low, vmax=high)
+            axis.set_xticks([])
+            axis.set_yticks([])
+            for spine in axis.spines.values():
+                spine.set_linewidth(2.5 if column in active_indices else 0.5)
+                spine.set_color("red" if column in active_indices else "grey")
+            if row == 0:
+                axis.set_title(f"bin {column}", fontsize=8)
+        axes[row, 0].set_ylabel(f"{active} bins\nstep {int(snapshot['step'])}", fontsize=8)
+    figure.suptitle(f"{run_dir.name}: utilities over angle (vertical) x velocity; active bins outlined", fontsize=9)
+    figure.tight_layout()
+    path = out / f"q_values_{run_dir.name}.png"
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+    return path
+
+
+def plot_suite(table_path: Path, out: Path) -> list[Path]:
+    """All figures for a results table; returns the written paths."""
+    table = pd.read_csv(table_path)
+    if table.empty:
+        return []
+    paths = [*learning_curves(table, out), aggregate(table, out), *smoothness_radar(table, out)]
+    for run_dir in sorted((out / "runs").glob("*")):
+        picture = q_value_picture(run_dir, out)
+        if picture is not None:
+            paths.append(picture)
+    return paths
