@@ -121,6 +121,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
 
     env = Monitor(make_env(args.env, action_penalty=args.penalty))
     eval_env = Monitor(make_env(args.env, action_penalty=args.penalty))
+    eval_env.reset(seed=args.seed + 10_000)  # evaluation episodes' initial states follow the seed too
     common = dict(seed=args.seed, verbose=0, **hyperparams)
     if args.algo == "decqn":
         model: GQN = DecQN("MlpPolicy", env, bins=int(args.bins[-1]), **common)
