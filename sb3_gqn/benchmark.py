@@ -10,9 +10,10 @@ hyperparameter file of its algorithm, the penalty set in the entry's ``ActionPen
 budget given here), evaluates greedily every ``--eval-freq`` steps with :func:`~sb3_gqn.metrics.rollout_figures`
 and writes ``<out>/runs/<run>/curve.csv``; ``done.json`` marks it finished. Runs go to parallel
 processes (``--jobs``, default the core count, torch threads split between them). A second invocation
-skips finished runs and restarts interrupted ones from scratch. At the end ``<out>/results.csv`` holds
-every evaluation of every run of the suite (algo, env, penalty, seed, step, return, task return, wall
-time, smoothness figures) and :mod:`sb3_gqn.plots` draws the figures into ``<out>/``.
+skips finished runs (a ``done.json``, or the run's rows up to its budget in ``<out>/results.csv``, so a
+committed table can be extended by a later session) and restarts interrupted ones from scratch. At the
+end ``<out>/results.csv`` holds every evaluation of every run of the suite (algo, env, penalty, seed, step,
+return, task return, wall time, smoothness figures, growth events) and :mod:`sb3_gqn.plots` draws the figures into ``<out>/``.
 """
 
 from __future__ import annotations
@@ -37,6 +38,14 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from sb3_gqn.metrics import rollout_figures
 
+#: GQN-adaptive as it was before warm start, the plateau rule and shared exploration (issue 11's ablation)
+BEFORE_GROWTH_FIXES: dict[str, Any] = {
+    "growth": "adaptive",
+    "growth_init": "none",
+    "growth_patience": None,
+    "growth_eval_freq": 5_000,
+    "exploration": "per_dimension",
+}
 #: Algorithm variants: (rl-zoo3 algorithm, hyperparameter overrides on its shipped file)
 VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-adaptive": ("gqn", {"growth": "adaptive"}),
@@ -45,12 +54,18 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-9": ("decqn", {"bins": 9}),
     "sac": ("sac", {}),
     "td3": ("td3", {}),
+    # ablation: the old behaviour, then each change alone
+    "gqn-before": ("gqn", BEFORE_GROWTH_FIXES),
+    "gqn-before+warm-start": ("gqn", {**BEFORE_GROWTH_FIXES, "growth_init": "interpolate"}),
+    "gqn-before+plateau": ("gqn", {**BEFORE_GROWTH_FIXES, "growth_patience": 2, "growth_eval_freq": 2_500}),
+    "gqn-before+shared": ("gqn", {**BEFORE_GROWTH_FIXES, "exploration": "shared"}),
 }
+ABLATION = ["gqn-before", "gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared", "gqn-adaptive"]
 SHORT_SUITE = dict(
     algos=["gqn-linear", "decqn-2", "decqn-9", "sac"], envs=["Pendulum-v1"], penalties=[0.1], seeds=[0], steps=10_000
 )
 FULL_SUITE = dict(
-    algos=list(VARIANTS),
+    algos=["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9", "sac", "td3"],
     envs=[
         "dm_control/cartpole-swingup-v0",
         "dm_control/reacher-easy-v0",
@@ -81,7 +96,9 @@ COLUMNS = [
     "episode_length",
     "active_bins",
     "wall_time",
+    "growth_events",
 ]
+RUN_KEY = ("algo", "env", "penalty", "seed")
 
 
 @dataclass(frozen=True)
@@ -154,6 +171,7 @@ class BenchmarkCallback(BaseCallback):
             "episode_length": figures.episode_length,
             "active_bins": getattr(self.model, "active_bins", ""),
             "wall_time": round(self.train_seconds, 2),
+            "growth_events": " ".join(f"{step}:{bins}" for step, bins in getattr(self.model, "growth_events", [])),
         }
         with open(self.run_dir / "curve.csv", "a", newline="") as handle:
             writer = csv.DictWriter(handle, fieldnames=COLUMNS)
@@ -224,23 +242,62 @@ def run(spec: RunSpec, out: Path, eval_freq: int, eval_episodes: int, threads: i
     return spec.name
 
 
+def _run_key(row: dict[str, Any]) -> tuple[str, str, float, int]:
+    return str(row["algo"]), str(row["env"]), float(row["penalty"]), int(float(row["seed"]))
+
+
+def recorded_rows(table: Path) -> dict[tuple[str, str, float, int], list[dict[str, Any]]]:
+    """Rows of an existing ``results.csv`` grouped by run (algo, env, penalty, seed); empty if there is none.
+
+    Committed tables are how a later session (or machine) extends a suite: a run recorded there up to its
+    budget counts as finished even when its ``runs/`` folder is gone.
+    """
+    if not table.is_file():
+        return {}
+    runs: dict[tuple[str, str, float, int], list[dict[str, Any]]] = {}
+    with open(table, newline="") as handle:
+        for row in csv.DictReader(handle):
+            runs.setdefault(_run_key(row), []).append(row)
+    return runs
+
+
+def is_recorded(spec: RunSpec, recorded: dict[tuple[str, str, float, int], list[dict[str, Any]]]) -> bool:
+    """Whether ``results.csv`` holds ``spec`` evaluated up to its full budget."""
+    rows = recorded.get((spec.algo, spec.env, float(spec.penalty), spec.seed), [])
+    return any(int(float(row["step"])) >= spec.steps for row in rows)
+
+
+def is_finished(spec: RunSpec, out: Path, recorded: dict[tuple[str, str, float, int], list[dict[str, Any]]]) -> bool:
+    return (out / "runs" / spec.name / "done.json").is_file() or is_recorded(spec, recorded)
+
+
 def collect(specs: list[RunSpec], out: Path) -> Path:
-    """Concatenate the suite's finished curves into ``<out>/results.csv``."""
+    """Write ``<out>/results.csv``: the suite's finished curves, plus every run an earlier table recorded.
+
+    A run finished in ``runs/`` replaces its earlier rows; runs of other invocations are kept, so
+    invocations with different algorithms or seeds accumulate into one table.
+    """
     table = out / "results.csv"
-    with open(table, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+    rows_by_run = recorded_rows(table)
+    for spec in specs:
+        curve = out / "runs" / spec.name / "curve.csv"
+        if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
+            with open(curve, newline="") as rows:
+                rows_by_run[(spec.algo, spec.env, float(spec.penalty), spec.seed)] = list(csv.DictReader(rows))
+    with open(table.with_suffix(".csv.tmp"), "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
         writer.writeheader()
-        for spec in specs:
-            curve = out / "runs" / spec.name / "curve.csv"
-            if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
-                with open(curve, newline="") as rows:
-                    writer.writerows(csv.DictReader(rows))
+        for key in sorted(rows_by_run, key=lambda key: (key[1], key[2], key[0], key[3])):
+            writer.writerows({column: row.get(column, "") for column in COLUMNS} for row in rows_by_run[key])
+    os.replace(table.with_suffix(".csv.tmp"), table)
     return table
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--algos", nargs="+", choices=list(VARIANTS), help=f"default: {SHORT_SUITE['algos']}")
+    parser.add_argument(
+        "--algos", nargs="+", choices=list(VARIANTS), help=f"default: {SHORT_SUITE['algos']}; ablation: {ABLATION}"
+    )
     parser.add_argument("--envs", nargs="+", help=f"env ids with an entry in the shipped files; default {SHORT_SUITE['envs']}")
     parser.add_argument("--penalties", nargs="+", type=float, help="action penalty coefficients c")
     parser.add_argument("--seeds", nargs="+", type=int)
@@ -249,6 +306,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--eval-freq", type=int, help="env steps between evaluations (default: steps / 10)")
     parser.add_argument("--eval-episodes", type=int, default=3, help="greedy episodes per evaluation")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
+    parser.add_argument(
+        "--threads", type=int, help="torch threads per run (default: cores / jobs; lower it when other work shares the cores)"
+    )
     parser.add_argument("--out", default="results/benchmark", help="output folder")
     parser.add_argument("--list", action="store_true", help="list the runs and their state, train nothing")
     parser.add_argument("--no-plots", action="store_true")
@@ -263,7 +323,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 
 def _report(specs: list[RunSpec], out: Path, running: dict[str, RunSpec]) -> str:
-    done = sum((out / "runs" / spec.name / "done.json").is_file() for spec in specs)
+    recorded = recorded_rows(out / "results.csv")
+    done = sum(is_finished(spec, out, recorded) for spec in specs)
     parts = [f"[{done}/{len(specs)} runs done]"]
     for name, spec in running.items():
         progress = out / "runs" / name / "progress"
@@ -286,14 +347,15 @@ def main(argv: list[str] | None = None) -> int:
         for algo in args.algos
         for seed in args.seeds
     ]
-    pending = [spec for spec in specs if not (out / "runs" / spec.name / "done.json").is_file()]
+    recorded = recorded_rows(out / "results.csv")
+    pending = [spec for spec in specs if not is_finished(spec, out, recorded)]
     print(f"{len(specs)} runs, {len(specs) - len(pending)} already finished, {len(pending)} to train -> {out}")
     if args.list:
         for spec in specs:
             print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
         return 0
     jobs = max(1, min(args.jobs, len(pending) or 1))
-    threads = max(1, (os.cpu_count() or 1) // jobs)
+    threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)
     if pending:
         out.mkdir(parents=True, exist_ok=True)
         with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:

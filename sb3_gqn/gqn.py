@@ -18,8 +18,15 @@ from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_nam
 
 from sb3_gqn.buffers import PrioritizedReplayBuffer
 from sb3_gqn.envs import check_action_space, resolve_env
-from sb3_gqn.growth import GROWTH_SCHEDULES, AdaptiveGrowth, GrowthCallback, nested_bin_levels
-from sb3_gqn.masking import active_bin_indices, active_bin_mask, epsilon_greedy
+from sb3_gqn.growth import (
+    GROWTH_INITS,
+    GROWTH_SCHEDULES,
+    AdaptiveGrowth,
+    GrowthCallback,
+    interpolation_neighbours,
+    nested_bin_levels,
+)
+from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, active_bin_mask, epsilon_greedy
 from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
 from sb3_gqn.wrappers import BinGrid
@@ -79,9 +86,13 @@ class GQN(OffPolicyAlgorithm):
         **gradient steps** (DecQN's convention; SB3's DQN counts environment steps instead)
     :param exploration_fraction: fraction of entire training period over which epsilon goes from
         ``exploration_initial_eps`` to ``exploration_final_eps``
-    :param exploration_initial_eps: initial probability of a random bin per action dimension
-    :param exploration_final_eps: final probability of a random bin per action dimension
-        (DecQN and GQN use a constant 0.1)
+    :param exploration_initial_eps: initial exploration rate epsilon
+    :param exploration_final_eps: final exploration rate epsilon (DecQN and GQN use a constant 0.1)
+    :param exploration: how epsilon turns into random bins (:func:`~sb3_gqn.masking.random_dimension_probability`):
+        ``"shared"`` (DecQN's reference code, the default) spreads epsilon over all action dimensions, so each of
+        the ``M`` dimensions is random with probability ``(eps / M) / (1 - eps + eps / M)`` (about one random
+        dimension per ``1 / eps`` steps in total); ``"per_dimension"`` makes every dimension random with
+        probability epsilon
     :param max_grad_norm: The maximum value for the gradient clipping (if None, no clipping)
     :param prioritized_replay: sample transitions in proportion to ``(|td| + eps) ** priority_exponent``
         (Schaul et al. 2016, n-step, :class:`~sb3_gqn.buffers.PrioritizedReplayBuffer`) and weight the loss
@@ -93,8 +104,12 @@ class GQN(OffPolicyAlgorithm):
     :param bins: bins per action dimension: ``(initial, final)`` grows through the nested levels
         (``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and MultiDiscrete envs must
         have ``final`` choices per dimension.
-    :param growth: ``"adaptive"`` (paper eq. 4), ``"linear"`` (level g opens at g / (N + 1) of
-        ``total_timesteps``) or ``None`` (never grow)
+    :param growth: ``"adaptive"`` (paper eq. 4 plus the plateau rule), ``"linear"`` (level g opens at
+        g / (N + 1) of ``total_timesteps``) or ``None`` (stay at the first level of ``bins``)
+    :param growth_init: ``"interpolate"``: a newly opened bin's head weights and bias (online and target
+        network) become the mean of its two nested neighbours', so its utility starts as their mean and the
+        greedy policy does not jump when a level opens; ``"none"``: new bins keep the values they have (the
+        paper as written)
     :param growth_eval_freq: adaptive growth: environment steps between evaluations
     :param growth_eval_episodes: adaptive growth: greedy episodes per evaluation. They are interleaved
         in training (their transitions are stored and count as steps), see
@@ -103,6 +118,10 @@ class GQN(OffPolicyAlgorithm):
         standard deviation of eq. 4 (a decision needs a full window since the last growth)
     :param growth_returns: adaptive growth: ``"evaluation"`` (greedy episodes) or ``"training"``
         (every finished training episode)
+    :param growth_patience: adaptive growth: grow after this many returns in a row without improvement
+        (:func:`~sb3_gqn.growth.plateau`), which catches the flat plateaus eq. 4 cannot; ``None``: eq. 4 only
+    :param growth_min_improvement: adaptive growth: relative gain over the level's best return that counts
+        as an improvement for the plateau rule
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -145,6 +164,7 @@ class GQN(OffPolicyAlgorithm):
         exploration_fraction: float = 0.1,
         exploration_initial_eps: float = 0.1,
         exploration_final_eps: float = 0.1,
+        exploration: str = "shared",
         max_grad_norm: float | None = 40.0,
         prioritized_replay: bool = True,
         priority_exponent: float = 0.6,
@@ -152,10 +172,13 @@ class GQN(OffPolicyAlgorithm):
         importance_sampling_annealing: bool = False,
         bins: int | tuple[int, int] = (2, 9),
         growth: str | None = "adaptive",
-        growth_eval_freq: int = 5_000,
+        growth_init: str = "interpolate",
+        growth_eval_freq: int = 2_500,
         growth_eval_episodes: int = 1,
         growth_window: int = 3,
         growth_returns: str = "evaluation",
+        growth_patience: int | None = 2,
+        growth_min_improvement: float = 0.05,
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
         policy_kwargs: dict[str, Any] | None = None,
@@ -166,6 +189,10 @@ class GQN(OffPolicyAlgorithm):
     ):
         if growth not in GROWTH_SCHEDULES:
             raise ValueError(f"growth must be one of {GROWTH_SCHEDULES}, got {growth!r}")
+        if growth_init not in GROWTH_INITS:
+            raise ValueError(f"growth_init must be one of {GROWTH_INITS}, got {growth_init!r}")
+        if exploration not in EXPLORATION_MODES:
+            raise ValueError(f"exploration must be one of {EXPLORATION_MODES}, got {exploration!r}")
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
         env = resolve_env(env)  # type: ignore[assignment]
@@ -202,13 +229,17 @@ class GQN(OffPolicyAlgorithm):
         self.exploration_final_eps = exploration_final_eps
         self.exploration_fraction = exploration_fraction
         self.exploration_rate = exploration_initial_eps
+        self.exploration = exploration
         self.max_grad_norm = max_grad_norm
         self.prioritized_replay = prioritized_replay
         self.priority_exponent = priority_exponent
         self.importance_sampling_exponent = importance_sampling_exponent
         self.importance_sampling_annealing = importance_sampling_annealing
         self.growth = growth
+        self.growth_init = growth_init
         self.growth_level = 0
+        #: ``(env step, active bins)`` of every growth so far (saved with the model; plots mark them)
+        self.growth_events: list[tuple[int, int]] = []
         self.growth_schedule: AdaptiveGrowth | None = None
         if growth == "adaptive":
             self.growth_schedule = AdaptiveGrowth(
@@ -216,6 +247,8 @@ class GQN(OffPolicyAlgorithm):
                 eval_episodes=growth_eval_episodes,
                 window=growth_window,
                 returns_source=growth_returns,
+                patience=growth_patience,
+                min_improvement=growth_min_improvement,
             )
         if _init_setup_model:
             self._setup_model()
@@ -320,8 +353,17 @@ class GQN(OffPolicyAlgorithm):
         if level == self.growth_level:
             return
         previous_bins = self.active_bins
+        if getattr(self, "growth_init", "none") == "interpolate":
+            # One nested step at a time, so a jump over several levels interpolates from already warm bins
+            for step_level in range(self.growth_level + 1, level + 1):
+                self.policy.interpolate_bins(
+                    interpolation_neighbours(self.bin_levels[-1], self.bin_levels[step_level - 1], self.bin_levels[step_level])
+                )
         self.growth_level = level
         self._apply_growth_level()
+        if not hasattr(self, "growth_events"):  # models saved before growth events were recorded
+            self.growth_events = []
+        self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
         if getattr(self, "_logger", None) is not None:  # no logger before the first learn()
             self.logger.record("growth/active_bins", self.active_bins)
             self.logger.record("growth/level", self.growth_level)
@@ -355,7 +397,9 @@ class GQN(OffPolicyAlgorithm):
         else:
             greedy_rows = self.growth_schedule.greedy_envs if self.growth_schedule is not None else None
             greedy, _ = self.policy.predict(self._last_obs, deterministic=True)  # type: ignore[arg-type]
-            indices = epsilon_greedy(greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows)
+            indices = epsilon_greedy(
+                greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows, exploration=self.exploration
+            )
         return self.to_env_action(indices), indices
 
     def to_env_action(self, indices: np.ndarray) -> np.ndarray:
@@ -371,7 +415,7 @@ class GQN(OffPolicyAlgorithm):
     ) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:
         """
         The env's action for an observation: greedy over the active bins, plus per-dimension
-        epsilon-greedy exploration when ``deterministic=False``. For a Box env the bins are mapped
+        epsilon-greedy exploration (``exploration``) when ``deterministic=False``. For a Box env the bins are mapped
         to their continuous values (use ``model.policy.predict`` for the bin indices).
 
         :param observation: the input observation
@@ -382,7 +426,9 @@ class GQN(OffPolicyAlgorithm):
         """
         actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
         if not deterministic:
-            actions = epsilon_greedy(np.asarray(actions), self._active_bin_indices, self.exploration_rate)
+            actions = epsilon_greedy(
+                np.asarray(actions), self._active_bin_indices, self.exploration_rate, exploration=self.exploration
+            )
         return self.to_env_action(actions), state
 
     def _store_transition(

@@ -6,7 +6,11 @@
   active from the start) once ``g / (N + 1)`` of the total timesteps have passed, ``N`` being the
   number of levels.
 * ``growth="adaptive"``: :class:`AdaptiveGrowth` keeps a moving window of returns and grows when
-  the current return falls below the threshold of paper eq. 4 (:func:`adaptive_threshold`).
+  the current return falls below the threshold of paper eq. 4 (:func:`adaptive_threshold`), or when
+  the returns have stopped improving (:func:`plateau`, which eq. 4 cannot see: a flat return has
+  ``sigma = 0`` and never falls below ``0.95 mu``).
+* ``growth_init="interpolate"``: :func:`interpolation_neighbours` says which two active bins each
+  newly opened bin is warm-started from.
 
 :class:`GrowthCallback` drives either schedule during ``learn()``; GQN installs it itself.
 """
@@ -24,6 +28,7 @@ if TYPE_CHECKING:
     from sb3_gqn.gqn import GQN
 
 GROWTH_SCHEDULES = ("adaptive", "linear", None)
+GROWTH_INITS = ("interpolate", "none")
 RETURN_SOURCES = ("evaluation", "training")
 
 
@@ -65,6 +70,39 @@ def adaptive_threshold(mean: float, std: float) -> float:
     return (1.0 - 0.05 * float(np.sign(mean))) * mean + 0.9 * std
 
 
+def plateau(returns: list[float], patience: int, min_improvement: float = 0.05) -> bool:
+    """Patience rule: the last ``patience`` returns did not improve on the best return before them.
+
+    An improvement must exceed ``min_improvement * |best|`` (5 % by default, the margin eq. 4 uses), so
+    evaluation noise around a flat return does not count as progress. Needs ``patience + 1`` returns.
+    ``[-1000, -1000, -1000]`` with ``patience=2`` is a plateau; ``[10, 50, 52]`` is one (52 < 50 * 1.05);
+    ``[10, 50, 60]`` is not.
+
+    :param returns: returns since the last growth, oldest first
+    :param patience: evaluations without improvement before the rule fires
+    :param min_improvement: relative margin an improvement must exceed
+    """
+    if patience < 1 or len(returns) < patience + 1:
+        return False
+    best_before = max(returns[:-patience])
+    return max(returns[-patience:]) <= best_before + min_improvement * abs(best_before)
+
+
+def interpolation_neighbours(max_bins: int, previous_bins: int, active_bins: int) -> list[tuple[int, int, int]]:
+    """The bins one growth step opens, each with its two nested neighbours: ``(new, left, right)``.
+
+    Opening level ``active_bins`` from ``previous_bins`` (one doubling) halves the stride between active
+    bins; each new bin sits midway between two previously active ones. With 9 bins: 2 -> 3 opens bin 4
+    between 0 and 8; 3 -> 5 opens 2 (0, 4) and 6 (4, 8).
+
+    :raises ValueError: if ``active_bins`` is not the next nested level after ``previous_bins``
+    """
+    if active_bins != 2 * previous_bins - 1 or (max_bins - 1) % (active_bins - 1) != 0:
+        raise ValueError(f"{previous_bins} -> {active_bins} bins (of {max_bins}) is not one nested growth step")
+    stride = (max_bins - 1) // (active_bins - 1)
+    return [(new, new - stride, new + stride) for new in range(stride, max_bins - 1, 2 * stride)]
+
+
 def linear_growth_level(num_timesteps: int, total_timesteps: int, n_levels: int) -> int:
     """Level index the linear schedule has reached: level ``g`` opens at ``g / (N + 1)`` of training.
 
@@ -78,13 +116,21 @@ def linear_growth_level(num_timesteps: int, total_timesteps: int, n_levels: int)
 
 @dataclass
 class GrowthDecision:
-    """Outcome of one adaptive check: the compared return and the eq. 4 threshold (None while warming up)."""
+    """Outcome of one adaptive check: the compared return, the eq. 4 threshold (None while the window
+    fills) and, when ``grow``, which rule fired (``"eq. 4"`` or ``"plateau"``)."""
 
     current_return: float
     threshold: float | None
     window_mean: float | None
     window_std: float | None
     grow: bool
+    rule: str | None = None
+
+    def describe(self) -> str:
+        """One line for the console and the log."""
+        if self.rule == "plateau":
+            return f"return {self.current_return:.2f} stopped improving (plateau)"
+        return f"return {self.current_return:.2f} < eq. 4 threshold {self.threshold:.2f}"
 
 
 @dataclass
@@ -98,21 +144,33 @@ class AdaptiveGrowth:
     and count as environment steps, so no separate evaluation env or extra budget is needed, and it
     works for any env, wrapper stack or VecEnv that GQN trains on.
 
-    The window holds the last ``window`` returns since the most recent growth; a decision is made
-    once it is full. After a growth the window restarts, so the new level is judged on its own
-    returns and one dip cannot cascade through all levels.
+    Two rules decide, after every return, whether the next level opens:
+
+    * eq. 4 (:func:`adaptive_threshold`): the window holds the last ``window`` returns since the most
+      recent growth; once it is full, a return below the threshold grows;
+    * the plateau rule (:func:`plateau`): ``patience`` returns in a row without a ``min_improvement``
+      gain on the best return of the level grow. ``patience=None`` leaves eq. 4 alone (the paper as
+      written).
+
+    After a growth both restart, so the new level is judged on its own returns and one dip cannot
+    cascade through all levels.
 
     :param eval_freq: environment steps between evaluations
     :param eval_episodes: greedy episodes averaged into one evaluation return
     :param window: number of past returns in the moving mean and standard deviation
     :param returns_source: ``"evaluation"`` or ``"training"``
+    :param patience: returns without improvement before the plateau rule grows (``None``: off)
+    :param min_improvement: relative gain that counts as an improvement for the plateau rule
     """
 
-    eval_freq: int = 5_000
+    eval_freq: int = 2_500
     eval_episodes: int = 1
     window: int = 3
     returns_source: str = "evaluation"
+    patience: int | None = 2
+    min_improvement: float = 0.05
     history: list[float] = field(default_factory=list)
+    level_returns: list[float] = field(default_factory=list)
     next_eval_step: int = 0
     pending_episodes: int = 0
     finished_eval_returns: list[float] = field(default_factory=list)
@@ -124,10 +182,23 @@ class AdaptiveGrowth:
             raise ValueError(f"growth_returns must be one of {RETURN_SOURCES}, got {self.returns_source!r}")
         for name in ("eval_freq", "eval_episodes", "window"):
             value = getattr(self, name)
-            if not isinstance(value, (int, np.integer)) or value < 1:
+            if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
                 raise ValueError(f"growth {name} must be a positive integer, got {value!r}")
+        if self.patience is not None and (
+            not isinstance(self.patience, (int, np.integer)) or isinstance(self.patience, bool) or self.patience < 1
+        ):
+            raise ValueError(f"growth_patience must be a positive integer or None, got {self.patience!r}")
+        if not np.isfinite(self.min_improvement) or self.min_improvement < 0:
+            raise ValueError(f"growth_min_improvement must be a finite number >= 0, got {self.min_improvement!r}")
         if self.next_eval_step == 0:
             self.next_eval_step = self.eval_freq
+
+    def __setstate__(self, state: dict) -> None:
+        # Models saved before the plateau rule existed: eq. 4 alone, the level's returns start from the window
+        state.setdefault("patience", None)
+        state.setdefault("min_improvement", 0.05)
+        state.setdefault("level_returns", list(state.get("history", [])))
+        self.__dict__.update(state)
 
     def start(self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0) -> None:
         """Prepare per-env bookkeeping at the start of ``learn()``.
@@ -174,19 +245,24 @@ class AdaptiveGrowth:
         return decisions
 
     def decide(self, current_return: float) -> GrowthDecision:
-        """Compare ``current_return`` with eq. 4 over the window; grow when it falls below."""
-        if len(self.history) < self.window:
-            self.history.append(current_return)
-            return GrowthDecision(current_return, None, None, None, grow=False)
-        window_mean = float(np.mean(self.history))
-        window_std = float(np.std(self.history))
-        threshold = adaptive_threshold(window_mean, window_std)
-        grow = current_return < threshold
-        if grow:
+        """Apply eq. 4 over the window and the plateau rule over the level's returns; grow if either fires."""
+        self.level_returns.append(current_return)
+        threshold = window_mean = window_std = None
+        rule = None
+        if len(self.history) >= self.window:
+            window_mean = float(np.mean(self.history))
+            window_std = float(np.std(self.history))
+            threshold = adaptive_threshold(window_mean, window_std)
+            if current_return < threshold:
+                rule = "eq. 4"
+        if rule is None and self.patience is not None and plateau(self.level_returns, self.patience, self.min_improvement):
+            rule = "plateau"
+        if rule is not None:
             self.history = []
+            self.level_returns = []
         else:
-            self.history = [*self.history[1:], current_return]
-        return GrowthDecision(current_return, threshold, window_mean, window_std, grow)
+            self.history = [*self.history, current_return][-self.window :]
+        return GrowthDecision(current_return, threshold, window_mean, window_std, grow=rule is not None, rule=rule)
 
     def stop_evaluating(self) -> None:
         """No further levels: stop scheduling greedy episodes."""
@@ -215,7 +291,7 @@ class GrowthCallback(BaseCallback):
 
     def _on_step(self) -> bool:
         model = self.model
-        if model.growth_level >= len(model.bin_levels) - 1:
+        if model.growth is None or model.growth_level >= len(model.bin_levels) - 1:
             return True
         if model.growth == "linear":
             target = linear_growth_level(model.num_timesteps, model._total_timesteps, len(model.bin_levels))
@@ -234,10 +310,7 @@ class GrowthCallback(BaseCallback):
             if decision.grow and model.growth_level < len(model.bin_levels) - 1:
                 model.grow(
                     model.growth_level + 1,
-                    reason=(
-                        f"{schedule.returns_source} return {decision.current_return:.2f} < "
-                        f"eq. 4 threshold {decision.threshold:.2f} at step {model.num_timesteps}"
-                    ),
+                    reason=f"{schedule.returns_source} {decision.describe()} at step {model.num_timesteps}",
                 )
                 if model.growth_level >= len(model.bin_levels) - 1:
                     schedule.stop_evaluating()

@@ -57,31 +57,64 @@ def masked_max(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
     return q_values.masked_fill(~mask, -th.inf).amax(dim=-1)
 
 
+EXPLORATION_MODES = ("shared", "per_dimension")
+
+
+def random_dimension_probability(epsilon: float, action_dims: int, exploration: str = "shared") -> float:
+    """Probability that one action dimension takes a uniformly drawn bin instead of its greedy bin.
+
+    ``"per_dimension"``: every dimension independently with probability ``epsilon``.
+
+    ``"shared"`` (DecQN's reference ``epsilon_greedy`` in decoupled mode): the dither mass ``epsilon`` is
+    spread over all ``bins * M`` utilities, ``epsilon / (bins M)`` each, the greedy bin gets ``1 - epsilon``,
+    and each dimension's categorical is renormalized by ``1 - epsilon + epsilon / M``. A dimension is
+    therefore random with probability ``(epsilon / M) / (1 - epsilon + epsilon / M)``: ``epsilon`` for
+    ``M = 1``, 1.8 % per dimension for ``M = 6`` and ``epsilon = 0.1``.
+
+    :param epsilon: the exploration rate in ``[0, 1]``
+    :param action_dims: ``M``, the number of action dimensions
+    :param exploration: ``"shared"`` or ``"per_dimension"``
+    """
+    if exploration == "per_dimension":
+        return float(epsilon)
+    if exploration != "shared":
+        raise ValueError(f"exploration must be one of {EXPLORATION_MODES}, got {exploration!r}")
+    if epsilon <= 0.0:
+        return 0.0
+    dither = epsilon / action_dims
+    return dither / (1.0 - epsilon + dither)
+
+
 def epsilon_greedy(
     greedy_actions: np.ndarray,
     allowed: np.ndarray,
     epsilon: float,
     rng: np.random.Generator | None = None,
     greedy_rows: np.ndarray | None = None,
+    exploration: str = "per_dimension",
 ) -> np.ndarray:
     """Decoupled epsilon-greedy exploration over the active bins.
 
-    Each action dimension of each row independently keeps its greedy bin with probability
-    ``1 - epsilon`` or is replaced by a bin drawn uniformly from ``allowed`` (as DecQN's
-    per-dimension categorical). Rows flagged in ``greedy_rows`` are left greedy.
+    Each action dimension of each row independently keeps its greedy bin or is replaced by a bin drawn
+    uniformly from ``allowed`` (which may be the greedy bin again), with the probability
+    :func:`random_dimension_probability` gives for ``exploration``. Rows flagged in ``greedy_rows`` are
+    left greedy.
 
-    :param greedy_actions: int array ``(n_envs,)`` or ``(n_envs, action_dims)``
+    :param greedy_actions: int array ``(n_envs,)`` (one dimension) or ``(n_envs, action_dims)``
     :param allowed: the active bin indices (see :func:`active_bin_indices`)
-    :param epsilon: probability of a random bin per dimension
+    :param epsilon: the exploration rate
     :param rng: random generator (defaults to NumPy's global state, which SB3 seeds)
     :param greedy_rows: optional bool array ``(n_envs,)``; ``True`` rows are never explored
+    :param exploration: ``"shared"`` (DecQN's reference) or ``"per_dimension"``
     :return: actions of the same shape, every entry inside ``allowed``
     """
-    if epsilon <= 0.0:
+    action_dims = 1 if greedy_actions.ndim < 2 else int(greedy_actions.shape[-1])
+    probability = random_dimension_probability(epsilon, action_dims, exploration)
+    if probability <= 0.0:
         return greedy_actions
     uniform = np.random.random if rng is None else rng.random
     integers = np.random.randint if rng is None else rng.integers
-    explore = uniform(greedy_actions.shape) < epsilon
+    explore = uniform(greedy_actions.shape) < probability
     if greedy_rows is not None:
         explore[np.asarray(greedy_rows, dtype=bool)] = False
     if not explore.any():

@@ -84,8 +84,12 @@ def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
             )
             half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
             for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
-                axis.plot(x, curve["mean"], label=f"{algo} ({int(curve['count'].max())} seeds)")
+                seeds = int(curve["count"].max())
+                (line,) = axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})")
                 axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2)
+            _mark_growth_events(axes[0], runs, curve, line.get_color())
+        if any(_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
+            axes[0].plot([], [], "v", color="grey", label="growth (new bin count)")
         axes[0].set_xlabel("environment steps")
         axes[1].set_xlabel("training wall time [s]")
         axes[0].set_ylabel("greedy return (penalized)")
@@ -99,17 +103,34 @@ def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
     return paths
 
 
+def _growth_events(runs: pd.DataFrame) -> list[tuple[int, int]]:
+    """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row."""
+    if "growth_events" not in runs or runs.empty:
+        return []
+    text = runs.sort_values("step")["growth_events"].iloc[-1]
+    if not isinstance(text, str) or not text.strip():
+        return []
+    return [(int(step), int(bins)) for step, bins in (event.split(":") for event in text.split())]
+
+
+def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
+    """A triangle on the algorithm's mean curve at every growth of each of its seeds, labelled with the new bins."""
+    for _, run in runs.groupby("seed"):
+        for step, bins in _growth_events(run):
+            value = float(np.interp(step, curve.index.to_numpy(), curve["mean"].to_numpy()))
+            axis.plot([step], [value], "v", color=color, markersize=6, markeredgecolor="black", markeredgewidth=0.5)
+            axis.annotate(str(bins), (step, value), textcoords="offset points", xytext=(0, 6), fontsize=6, ha="center")
+
+
 def final_rows(table: pd.DataFrame) -> pd.DataFrame:
     """The last evaluation of every run."""
     last = table.groupby(["algo", "env", "penalty", "seed"])["step"].transform("max")
     return table[table["step"] == last]
 
 
-def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
-    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs."""
-    from rliable import library as rly
-    from rliable import metrics as rly_metrics
-
+def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
+    """Final returns min-max normalized per task (env, penalty) over all of that task's runs, as rliable wants
+    them: ``{algo: array (runs, tasks)}`` (runs cut to the algorithm's smallest seed count) and the tasks."""
     final = final_rows(table).copy()
     task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
     final = final.join(task_range, on=["env", "penalty"])
@@ -122,7 +143,21 @@ def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
         n_runs = min(len(values) for values in per_task)
         if n_runs:
             scores[str(algo)] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
-    estimates, intervals = rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
+    return scores, tasks
+
+
+def iqm_with_intervals(scores: dict[str, np.ndarray], reps: int = 2000) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``)."""
+    from rliable import library as rly
+    from rliable import metrics as rly_metrics
+
+    return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
+
+
+def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
+    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs."""
+    scores, tasks = normalized_final_scores(table)
+    estimates, intervals = iqm_with_intervals(scores, reps)
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
     figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
     for row, algo in enumerate(algos):

@@ -249,6 +249,21 @@ class GQNPolicy(BasePolicy):
             raise ValueError(f"Expected a non-empty boolean mask of shape ({self.max_bins},), got {tuple(mask_tensor.shape)}")
         self.active_bins_mask.copy_(mask_tensor)
 
+    @th.no_grad()
+    def interpolate_bins(self, neighbours: list[tuple[int, int, int]]) -> None:
+        """Warm-start newly opened bins: each ``(new, left, right)`` bin's head row (weights and bias) becomes
+        the mean of its neighbours' rows, in every action dimension of the online and the target network.
+
+        The head is linear in the torso's features, so afterwards ``Q^j(s, new) = (Q^j(s, left) + Q^j(s, right)) / 2``
+        in every state: the greedy policy does not jump to an untrained bin when the level opens.
+        """
+        for network in (self.q_net, self.q_net_target):
+            weight = network.head.weight.view(self.action_dims, self.max_bins, -1)
+            bias = network.head.bias.view(self.action_dims, self.max_bins)
+            for new, left, right in neighbours:
+                weight[:, new] = 0.5 * (weight[:, left] + weight[:, right])
+                bias[:, new] = 0.5 * (bias[:, left] + bias[:, right])
+
     def forward(self, obs: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         return self._predict(obs, deterministic=deterministic)
 

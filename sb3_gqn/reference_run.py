@@ -84,7 +84,10 @@ def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
         writer.writerows(rows)
 
 
-def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str) -> None:
+def plot_learning_curve(
+    path: Path, rows: list[dict[str, Any]], title: str, growth_events: list[tuple[int, int]] | None = None
+) -> None:
+    """Greedy return and task return over env steps; a dotted line at every growth event."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -94,12 +97,15 @@ def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str) -> N
     figure, axis = plt.subplots(figsize=(6.4, 4.0))
     axis.plot(steps, [row["return_mean"] for row in rows], marker="o", label="return (penalized)")
     axis.plot(steps, [row["task_return_mean"] for row in rows], marker=".", linestyle="--", label="task return")
-    previous_bins = None
-    for row in rows:
-        if row["active_bins"] is not None and row["active_bins"] != previous_bins:
-            axis.axvline(row["step"], color="grey", alpha=0.3)
-            axis.annotate(f"{row['active_bins']} bins", (row["step"], axis.get_ylim()[0]), rotation=90, fontsize=7)
+    if growth_events is None:  # no exact record: mark where an evaluation first saw a new bin count
+        growth_events, previous_bins = [], None
+        for row in rows:
+            if row["active_bins"] is not None and row["active_bins"] != previous_bins and previous_bins is not None:
+                growth_events.append((row["step"], row["active_bins"]))
             previous_bins = row["active_bins"]
+    for step, bins in growth_events:
+        axis.axvline(step, color="grey", alpha=0.4, linestyle=":")
+        axis.annotate(f"-> {bins} bins", (step, axis.get_ylim()[0]), rotation=90, fontsize=7, va="bottom")
     axis.set_xlabel("environment steps")
     axis.set_ylabel("episode return (greedy)")
     axis.set_title(title, fontsize=9)
@@ -139,7 +145,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
 
     model.save(out / "model.zip")
     write_csv(out / "learning_curve.csv", curve.rows)
-    plot_learning_curve(out / "learning_curve.png", curve.rows, f"{run_name(args)} (sb3-gqn {__version__})")
+    plot_learning_curve(
+        out / "learning_curve.png", curve.rows, f"{run_name(args)} (sb3-gqn {__version__})", list(model.growth_events)
+    )
     summary = {
         "run": run_name(args),
         "args": vars(args),
@@ -150,6 +158,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "train_seconds": curve.rows[-1]["train_seconds"] if curve.rows else wall_seconds,
         "env_steps_per_second": model.num_timesteps / wall_seconds,
         "final_active_bins": model.active_bins,
+        "growth_events": [{"step": step, "active_bins": bins} for step, bins in model.growth_events],
         "final_evaluation": final.as_dict(),
         "machine": {"python": platform.python_version(), "torch": th.__version__, "threads": th.get_num_threads()},
     }

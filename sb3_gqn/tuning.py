@@ -27,16 +27,20 @@ def _sample_common(trial: optuna.Trial) -> None:
     trial.suggest_categorical("train_freq", [1, 2, 4, 8])
     trial.suggest_categorical("net_arch", list(NET_ARCHS))
     trial.suggest_float("epsilon", 0.01, 0.3, log=True)
+    trial.suggest_categorical("exploration", ["shared", "per_dimension"])
 
 
 def sample_gqn_params(
     trial: optuna.Trial, n_actions: int = 0, n_envs: int = 1, additional_args: dict | None = None
 ) -> dict[str, Any]:
     """GQN search space: learning rate, batch size, n-step, target update interval, train frequency,
-    network size, epsilon, bins pair and growth schedule (rl-zoo3 sampler signature)."""
+    network size, epsilon and its exploration mode, bins pair, growth schedule, the plateau rule's patience
+    (0: eq. 4 alone) and the warm start of opened bins (rl-zoo3 sampler signature)."""
     _sample_common(trial)
     trial.suggest_categorical("bins", list(GQN_BINS))
     trial.suggest_categorical("growth", ["adaptive", "linear"])
+    trial.suggest_categorical("growth_patience", [0, 1, 2, 3])
+    trial.suggest_categorical("growth_init", ["interpolate", "none"])
     return convert_gqn_params(trial.params)
 
 
@@ -56,6 +60,8 @@ def convert_gqn_params(params: dict[str, Any]) -> dict[str, Any]:
     hyperparams["exploration_initial_eps"] = epsilon
     hyperparams["exploration_final_eps"] = epsilon
     hyperparams["policy_kwargs"] = dict(net_arch=NET_ARCHS[hyperparams.pop("net_arch")])
+    if "growth_patience" in hyperparams:  # storages hold no None: 0 means the plateau rule is off
+        hyperparams["growth_patience"] = int(hyperparams["growth_patience"]) or None
     if isinstance(hyperparams["bins"], str):
         initial, final = hyperparams["bins"].split("-")
         hyperparams["bins"] = (int(initial), int(final))

@@ -38,3 +38,11 @@ class NaNRewardEnv(DecliningEnv):
     def step(self, action):
         obs, _, terminated, truncated, info = super().step(action)
         return obs, float("nan") if self.t == 3 else 0.0, terminated, truncated, info
+
+
+class FlatEnv(DecliningEnv):
+    """Every episode returns exactly ``-length``: a flat plateau (sigma = 0), invisible to paper eq. 4."""
+
+    def step(self, action):
+        obs, _, terminated, truncated, info = super().step(action)
+        return obs, -1.0, terminated, truncated, info

@@ -12,6 +12,15 @@ TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps"
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
 
 
+def _drop_rows(table, algo):
+    with open(table, newline="") as handle:
+        rows = [row for row in csv.DictReader(handle) if row["algo"] != algo]
+    with open(table, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
 def test_penalized_wrappers_replace_only_the_penalty():
     flatten = "gymnasium.wrappers.FlattenObservation"
     entry = [flatten, {"sb3_gqn.wrappers.ActionPenalty": {"coef": 0.1}}]
@@ -55,6 +64,7 @@ def test_tiny_suite_end_to_end_and_resume(tmp_path, capsys):
     interrupted = out / "runs" / "gqn-linear__Pendulum-v1__c0.1__seed0"
     (interrupted / "done.json").unlink()
     (interrupted / "curve.csv").write_text("garbage from a killed run\n")
+    _drop_rows(out / "results.csv", "gqn-linear")  # a killed run never reached the table
     capsys.readouterr()
     assert main(["--algos", "gqn-linear", "sac", *TINY, "--out", str(out), "--no-plots"]) == 0
     assert "2 runs, 1 already finished, 1 to train" in capsys.readouterr().out
@@ -62,3 +72,48 @@ def test_tiny_suite_end_to_end_and_resume(tmp_path, capsys):
     assert (interrupted / "done.json").is_file() and "garbage" not in (interrupted / "curve.csv").read_text()
     assert main(["--algos", "gqn-linear", "sac", *TINY, "--out", str(out), "--list"]) == 0
     assert "2 runs, 2 already finished, 0 to train" in capsys.readouterr().out
+
+
+def test_a_committed_table_alone_resumes_and_accumulates(tmp_path, capsys):
+    # A later session has only the committed results.csv (runs/ is not in git): recorded runs are not retrained,
+    # and a new invocation with another algorithm adds its rows to the same table.
+    out = tmp_path / "suite"
+    assert main(["--algos", "decqn-2", *TINY, "--out", str(out), "--no-plots"]) == 0
+    table = out / "results.csv"
+    decqn_rows = table.read_text().splitlines()[1:]
+    for run_dir in (out / "runs").iterdir():
+        for path in sorted(run_dir.rglob("*"), reverse=True):
+            path.unlink() if path.is_file() else path.rmdir()
+        run_dir.rmdir()
+    capsys.readouterr()
+    assert main(["--algos", "decqn-2", *TINY, "--out", str(out), "--list"]) == 0
+    assert "1 runs, 1 already finished, 0 to train" in capsys.readouterr().out
+    assert main(["--algos", "decqn-2", "gqn-adaptive", *TINY, "--out", str(out), "--no-plots"]) == 0
+    assert "2 runs, 1 already finished, 1 to train" in capsys.readouterr().out
+    with open(table, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert sorted({row["algo"] for row in rows}) == ["decqn-2", "gqn-adaptive"]
+    assert [line for line in table.read_text().splitlines()[1:] if line.startswith("decqn-2")] == decqn_rows
+    assert all(row["growth_events"] == "" for row in rows if row["algo"] == "decqn-2")
+
+
+def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
+    from sb3_gqn.benchmark import ABLATION, BEFORE_GROWTH_FIXES, VARIANTS
+
+    assert BEFORE_GROWTH_FIXES == {
+        "growth": "adaptive",
+        "growth_init": "none",
+        "growth_patience": None,
+        "growth_eval_freq": 5_000,
+        "exploration": "per_dimension",
+    }
+    for name in ABLATION[1:-1]:
+        changed = {key for key, value in VARIANTS[name][1].items() if BEFORE_GROWTH_FIXES.get(key) != value}
+        assert (
+            changed
+            == {
+                "gqn-before+warm-start": {"growth_init"},
+                "gqn-before+plateau": {"growth_patience", "growth_eval_freq"},
+                "gqn-before+shared": {"exploration"},
+            }[name]
+        )

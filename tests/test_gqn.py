@@ -94,6 +94,7 @@ def test_adaptive_evaluation_episodes_are_greedy():
         growth="adaptive",
         growth_eval_freq=50,
         growth_window=1000,  # never decides: we only look at the actions
+        growth_patience=None,
         exploration_initial_eps=1.0,
         exploration_final_eps=1.0,
         gradient_steps=0,
@@ -120,7 +121,9 @@ def test_adaptive_evaluation_episodes_are_greedy():
 
 def test_save_load_round_trip(tmp_path):
     # a window longer than the run: the schedule collects statistics but never decides
-    model = GQN("MlpPolicy", DecliningEnv(), growth="adaptive", growth_eval_freq=10, growth_window=100, **SMALL)
+    model = GQN(
+        "MlpPolicy", DecliningEnv(), growth="adaptive", growth_eval_freq=10, growth_window=100, growth_patience=None, **SMALL
+    )
     model.learn(150)
     assert len(model.growth_schedule.history) >= 10
     model.grow(2)
@@ -240,3 +243,101 @@ def test_sb3_evaluation_tools_work_on_the_box_env():
     rewards, _ = evaluate_policy(model, Monitor(ActionPenalty(DecliningEnv(), coef=0.1)), 2, return_episode_rewards=True)
     # episode 1 of a fresh env: reward -1/5 per step over 5 steps, penalty 0.1 * 2 (both dims at a bang-bang bin)
     assert rewards[0] == pytest.approx(-1.0 - 5 * 0.2)
+
+
+def _randomize_head(model):
+    # a trained-looking head: every bin's utility differs, so the warm-start identity is not trivially met
+    generator = th.Generator().manual_seed(0)
+    with th.no_grad():
+        for network in (model.q_net, model.q_net_target):
+            network.head.weight.copy_(th.randn(network.head.weight.shape, generator=generator))
+            network.head.bias.copy_(th.randn(network.head.bias.shape, generator=generator))
+        model.q_net_target.torso.load_state_dict(model.q_net.torso.state_dict())
+
+
+def test_interpolate_warm_start_sets_new_bins_to_the_mean_of_their_neighbours():
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth=None, bins=(2, 9), **SMALL)
+    _randomize_head(model)
+    observations = th.as_tensor(np.random.default_rng(0).normal(size=(100, 3)), dtype=th.float32)
+    befores = [network(observations).detach() for network in (model.q_net, model.q_net_target)]
+    for before in befores:
+        assert not th.allclose(before[..., 4], (before[..., 0] + before[..., 8]) / 2)
+    model.grow()  # 2 -> 3 opens bin 4 between 0 and 8
+    for network, before in zip((model.q_net, model.q_net_target), befores, strict=True):
+        q = network(observations).detach()
+        th.testing.assert_close(q[..., 4], (q[..., 0] + q[..., 8]) / 2)
+        # the bins that were active keep their utilities, so the greedy action over {0, 8} is unchanged
+        th.testing.assert_close(q[..., [0, 8]], before[..., [0, 8]])
+    model.grow()  # 3 -> 5 opens 2 (0, 4) and 6 (4, 8)
+    q = model.q_net(observations).detach()
+    th.testing.assert_close(q[..., 2], (q[..., 0] + q[..., 4]) / 2)
+    th.testing.assert_close(q[..., 6], (q[..., 4] + q[..., 8]) / 2)
+    # the new bin sits between its neighbours, so it can only win the argmax in a tie
+    assert bool((q[..., 4] <= th.maximum(q[..., 0], q[..., 8]) + 1e-6).all())
+
+
+def test_a_jump_over_several_levels_interpolates_level_by_level():
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=2), growth=None, bins=(2, 9), **SMALL)
+    _randomize_head(model)
+    model.grow(3)
+    q = model.q_net(th.zeros(5, 3)).detach()
+    # 2 -> 9 at once: every bin is then the linear interpolation of bins 0 and 8
+    for bin_index in range(9):
+        th.testing.assert_close(q[..., bin_index], q[..., 0] + (q[..., 8] - q[..., 0]) * bin_index / 8)
+
+
+def test_growth_init_none_leaves_the_new_bins_as_they_are():
+    model = GQN("MlpPolicy", DecliningEnv(), growth=None, growth_init="none", bins=(2, 9), **SMALL)
+    _randomize_head(model)
+    weights = model.q_net.head.weight.detach().clone()
+    model.grow()
+    assert th.equal(model.q_net.head.weight, weights)
+
+
+def test_masked_bins_have_zero_adam_moments_before_they_open():
+    # Inactive bins never enter the loss, so their head rows get exactly zero gradients and Adam's moment
+    # estimates for them stay exactly zero: opening them needs no optimizer reset.
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=2), growth=None, bins=(2, 9), train_freq=1, **SMALL)
+    model.learn(400)
+    assert model._n_updates > 0
+    state = model.policy.optimizer.state[model.q_net.head.weight]
+    for moment in (state["exp_avg"], state["exp_avg_sq"]):
+        rows = moment.view(2, 9, -1)
+        assert bool((rows[:, 1:8] == 0).all())
+        assert bool((rows[:, [0, 8]] != 0).any())
+    bias_state = model.policy.optimizer.state[model.q_net.head.bias]
+    assert bool((bias_state["exp_avg"].view(2, 9)[:, 1:8] == 0).all())
+
+
+def test_growth_none_with_a_bins_pair_trains_at_the_first_level():
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, **SMALL)
+    model.learn(600)
+    assert model.active_bins == 2 and model.growth_level == 0
+    stored = model.replay_buffer.actions[: model.replay_buffer.pos]
+    assert set(np.unique(stored)) <= {0, 8}
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(growth="adaptive", growth_init="interpolate", exploration="shared", growth_patience=2),
+        dict(growth="adaptive", growth_init="none", exploration="per_dimension", growth_patience=None),
+        dict(growth="adaptive", growth_returns="training", growth_patience=1, growth_min_improvement=0.0),
+        dict(growth="linear", growth_init="none", exploration="per_dimension"),
+        dict(growth=None, exploration="shared"),
+    ],
+)
+def test_every_growth_and_exploration_option_learns(options):
+    model = GQN("MlpPolicy", DecliningEnv(), growth_eval_freq=10, **options, **SMALL)
+    model.learn(400)
+    assert model.num_timesteps == 400 and model._n_updates > 0
+    assert model.exploration == options.get("exploration", "shared")
+
+
+def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
+    from tests.envs import FlatEnv
+
+    eq4_only = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=None, **SMALL).learn(400)
+    assert eq4_only.active_bins == 2
+    with_plateau = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=2, **SMALL).learn(400)
+    assert with_plateau.active_bins == 9

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from sb3_gqn.growth import AdaptiveGrowth, adaptive_threshold, linear_growth_level
+from sb3_gqn.growth import AdaptiveGrowth, adaptive_threshold, interpolation_neighbours, linear_growth_level, plateau
 
 
 def test_adaptive_threshold_positive_mean():
@@ -26,7 +26,7 @@ def test_linear_schedule_growth_steps():
 
 
 def test_adaptive_window_decisions():
-    schedule = AdaptiveGrowth(eval_freq=10, eval_episodes=1, window=3, returns_source="training")
+    schedule = AdaptiveGrowth(eval_freq=10, eval_episodes=1, window=3, returns_source="training", patience=None)
     # the first three returns only fill the window
     assert [schedule.decide(r).threshold for r in (1.0, 2.0, 3.0)] == [None, None, None]
     # window [1, 2, 3]: threshold 2.63485; 3.0 is above it -> no growth, window slides to [2, 3, 3]
@@ -76,3 +76,50 @@ def test_adaptive_restarts_evaluation_clock_when_step_counter_resets():
     assert schedule.next_eval_step == 100
     schedule.start(n_envs=1, env_was_reset=False, num_timesteps=40)  # continuing keeps its clock
     assert schedule.next_eval_step == 100
+
+
+def test_plateau_rule_hand_values():
+    # needs patience + 1 returns
+    assert not plateau([-1000.0, -1000.0], patience=2)
+    # flat penalty-dominated returns: eq. 4 never fires (sigma = 0), the plateau rule does
+    assert plateau([-1000.0, -1000.0, -1000.0], patience=2)
+    # best before the last two is 50; 52 < 50 + 0.05 * 50 = 52.5 is no improvement, 60 is
+    assert plateau([10.0, 50.0, 48.0, 52.0], patience=2)
+    assert not plateau([10.0, 50.0, 48.0, 60.0], patience=2)
+    # negative returns: best -200, margin 0.05 * 200 = 10: -195 is no improvement, -185 is
+    assert plateau([-300.0, -200.0, -195.0], patience=1)
+    assert not plateau([-300.0, -200.0, -185.0], patience=1)
+    # a steadily rising curve never plateaus
+    assert not any(plateau([1.0, 2.0, 4.0, 8.0, 16.0][: k + 1], patience=2) for k in range(5))
+
+
+def test_eq4_alone_never_fires_on_a_flat_return_and_the_plateau_rule_does():
+    eq4_only = AdaptiveGrowth(window=3, patience=None, returns_source="training")
+    # window [-1000] * 3: mu = -1000, sigma = 0, threshold 1.05 * -1000 = -1050; -1000 is above it, forever
+    decisions = [eq4_only.decide(-1000.0) for _ in range(20)]
+    assert not any(d.grow for d in decisions)
+    assert decisions[-1].threshold == pytest.approx(-1050.0)
+    with_plateau = AdaptiveGrowth(window=3, patience=2, returns_source="training")
+    decisions = [with_plateau.decide(-1000.0) for _ in range(3)]
+    assert [d.grow for d in decisions] == [False, False, True]
+    assert decisions[-1].rule == "plateau" and decisions[-1].threshold is None  # the window was not full yet
+    assert with_plateau.history == [] and with_plateau.level_returns == []  # the next level starts afresh
+
+
+def test_eq4_fires_before_the_plateau_rule_when_both_would():
+    schedule = AdaptiveGrowth(window=2, patience=2, returns_source="training")
+    for value in (10.0, 10.0):
+        schedule.decide(value)
+    # window [10, 10]: threshold 9.5; 5 is below it (and would also be a plateau)
+    decision = schedule.decide(5.0)
+    assert decision.grow and decision.rule == "eq. 4" and decision.threshold == pytest.approx(9.5)
+
+
+def test_interpolation_neighbours_of_the_nested_levels():
+    assert interpolation_neighbours(9, 2, 3) == [(4, 0, 8)]
+    assert interpolation_neighbours(9, 3, 5) == [(2, 0, 4), (6, 4, 8)]
+    assert interpolation_neighbours(9, 5, 9) == [(1, 0, 2), (3, 2, 4), (5, 4, 6), (7, 6, 8)]
+    assert interpolation_neighbours(65, 9, 17)[:2] == [(4, 0, 8), (12, 8, 16)]
+    assert len(interpolation_neighbours(65, 33, 65)) == 32
+    with pytest.raises(ValueError, match="not one nested growth step"):
+        interpolation_neighbours(9, 2, 5)

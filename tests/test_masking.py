@@ -7,7 +7,14 @@ import pytest
 import torch as th
 
 from sb3_gqn.growth import nested_bin_levels
-from sb3_gqn.masking import active_bin_indices, active_bin_mask, epsilon_greedy, masked_argmax, masked_max
+from sb3_gqn.masking import (
+    active_bin_indices,
+    active_bin_mask,
+    epsilon_greedy,
+    masked_argmax,
+    masked_max,
+    random_dimension_probability,
+)
 
 
 @pytest.mark.parametrize(
@@ -88,3 +95,41 @@ def test_epsilon_greedy_respects_greedy_rows_and_zero_epsilon():
     actions = epsilon_greedy(greedy, np.array([0, 8]), 1.0, rng=rng, greedy_rows=np.array([True, False, True, False]))
     assert actions[[0, 2]].tolist() == [[0, 0], [0, 0]]
     assert np.array_equal(epsilon_greedy(greedy, np.array([0, 8]), 0.0, rng=rng), greedy)
+
+
+@pytest.mark.parametrize(
+    "exploration, action_dims, per_dimension, any_dimension",
+    [
+        # M = 1: both modes are plain epsilon-greedy
+        ("shared", 1, 0.1, 0.1),
+        ("per_dimension", 1, 0.1, 0.1),
+        # M = 6, shared (DecQN's reference): (0.1 / 6) / (0.9 + 0.1 / 6) = 1 / 55; any of 6: 1 - (54 / 55) ** 6
+        ("shared", 6, 1 / 55, 0.104250),
+        # M = 6, per dimension: 0.1 each; any of 6: 1 - 0.9 ** 6
+        ("per_dimension", 6, 0.1, 0.468559),
+    ],
+)
+def test_random_dimension_rates_match_the_formulas(exploration, action_dims, per_dimension, any_dimension):
+    assert random_dimension_probability(0.1, action_dims, exploration) == pytest.approx(per_dimension, rel=1e-9)
+    # greedy bin 99 is not among the allowed bins, so every explored entry differs from it
+    greedy = np.full((300_000, action_dims), 99)
+    actions = epsilon_greedy(greedy, np.array([0, 4, 8]), 0.1, rng=np.random.default_rng(3), exploration=exploration)
+    random_entries = actions != 99
+    assert random_entries.mean() == pytest.approx(per_dimension, abs=1.5e-3)
+    assert random_entries.any(axis=1).mean() == pytest.approx(any_dimension, abs=3e-3)
+    assert 1 - (1 - per_dimension) ** action_dims == pytest.approx(any_dimension, abs=1e-6)
+
+
+def test_shared_exploration_equals_the_reference_categorical():
+    # DecQN's epsilon_greedy: probs = eps / (n M) + (1 - eps) [greedy], renormalized per dimension.
+    # M = 2, n = 3 active bins, eps = 0.3: Z = 0.7 + 0.15 = 0.85; each bin 0.05 / 0.85, greedy +0.7 / 0.85
+    rng = np.random.default_rng(4)
+    greedy = np.full((200_000, 2), 4)
+    actions = epsilon_greedy(greedy, np.array([0, 4, 8]), 0.3, rng=rng, exploration="shared")
+    frequencies = [(actions == bin_index).mean() for bin_index in (0, 4, 8)]
+    assert frequencies == pytest.approx([0.05 / 0.85, 0.75 / 0.85, 0.05 / 0.85], abs=2e-3)
+
+
+def test_unknown_exploration_mode():
+    with pytest.raises(ValueError, match="exploration must be one of"):
+        random_dimension_probability(0.1, 2, "bogus")

@@ -77,8 +77,11 @@ def test_converter_reproduces_the_sampler():
         "train_freq": 4,
         "net_arch": "small",
         "epsilon": 0.05,
+        "exploration": "per_dimension",
         "bins": "9-65",
         "growth": "linear",
+        "growth_patience": 0,
+        "growth_init": "none",
     }
     assert convert_gqn_params(params) == {
         "learning_rate": 3e-4,
@@ -88,9 +91,12 @@ def test_converter_reproduces_the_sampler():
         "train_freq": 4,
         "exploration_initial_eps": 0.05,
         "exploration_final_eps": 0.05,
+        "exploration": "per_dimension",
         "policy_kwargs": {"net_arch": [256, 256]},
         "bins": (9, 65),
         "growth": "linear",
+        "growth_patience": None,
+        "growth_init": "none",
     }
 
 
@@ -141,6 +147,13 @@ def test_gqn_cli_flags_reach_the_model(tmp_path):
     loaded = GQN.load(run_folder / "Pendulum-v1.zip")
     assert loaded.bin_levels == [3] and loaded.n_envs == 2
     assert list(run_folder.glob("rl_model_*_steps.zip")) and any((tmp_path / "tb").rglob("events.out.tfevents.*"))
+
+
+def test_growth_none_through_the_cli(tmp_path):
+    arguments = ["--algo", "gqn", "--env", "Pendulum-v1", "-f", str(tmp_path), *QUICK[:-2]]
+    assert train_main([*arguments, "-params", "learning_starts:100", "growth:None", "bins:(2,9)"]) == 0
+    loaded = GQN.load(tmp_path / "gqn" / "Pendulum-v1_1" / "Pendulum-v1.zip")
+    assert loaded.growth is None and loaded.active_bins == 2 and loaded.bin_levels == [2, 3, 5, 9]
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,56 @@
+"""The report's growth check and tables against hand-made results tables."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from sb3_gqn.report import growth_checks, held_after_growth, report
+
+
+def test_held_after_growth_hand_values():
+    assert held_after_growth(500.0, 350.0)  # exactly 70 %
+    assert not held_after_growth(500.0, 349.0)
+    assert held_after_growth(40.0, -10.0)  # below 100: within 50
+    assert not held_after_growth(40.0, -11.0)
+    assert held_after_growth(-500.0, -550.0) and not held_after_growth(-500.0, -551.0)
+
+
+def _row(algo, seed, step, value, events=""):
+    return dict(
+        algo=algo,
+        env="dm_control/cartpole-swingup-v0",
+        penalty=0.1,
+        seed=seed,
+        step=step,
+        **{"return": value},
+        task_return=value + 10,
+        action_penalty=10.0,
+        action_magnitude=0.5,
+        action_change=0.1,
+        smoothness=0.01,
+        smoothness_freq=100.0,
+        episode_length=1000,
+        active_bins=9,
+        wall_time=step / 100,
+        growth_events=events,
+    )
+
+
+def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
+    table = pd.DataFrame(
+        [
+            _row("gqn-adaptive", 0, 10_000, 400.0, "8000:3"),
+            _row("gqn-adaptive", 0, 20_000, 500.0, "8000:3 19000:5"),
+            _row("gqn-adaptive", 0, 30_000, 200.0, "8000:3 19000:5 25000:9"),
+            _row("decqn-9", 0, 30_000, 600.0),
+        ]
+    )
+    checks = growth_checks(table)
+    assert [(c.step, c.bins, c.before_step, c.before, c.after_step, c.after, c.held) for c in checks] == [
+        (8000, 3, None, None, 10_000, 400.0, None),  # no evaluation before the first growth
+        (19000, 5, 10_000, 400.0, 20_000, 500.0, True),
+        (25000, 9, 20_000, 500.0, 30_000, 200.0, False),  # 200 < 0.7 * 500
+    ]
+    text = report(table, reps=50)
+    assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 30000 | 200 |" in text
+    assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 25000 -> 9 | 500 (20000) | 200 (30000) | **no** |" in text
