@@ -113,7 +113,7 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
         "return": "return",
         "task_return": "task return",
         "action_penalty": "P",
-        "action_change": "|Δa|",
+        "action_change": "\\|Δa\\|",  # escaped: a bare | splits a markdown cell
         "smoothness": "SM",
         "active_bins": "bins",
         "wall_time": "training s",
@@ -125,8 +125,10 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
     means = final.groupby(["env", "penalty", "algo"]).agg(
         seeds=("seed", "count"), mean_return=("return", "mean"), mean_SM=("smoothness", "mean")
     )
+    means = means.reset_index()
+    means["env"] = means["env"].str.replace("dm_control/", "", regex=False)
     sections.append("\n### Mean over seeds\n")
-    sections.append(_markdown(means.reset_index()))
+    sections.append(_markdown(means))
 
     checks = growth_checks(table)
     if checks:

@@ -123,3 +123,17 @@ def test_interpolation_neighbours_of_the_nested_levels():
     assert len(interpolation_neighbours(65, 33, 65)) == 32
     with pytest.raises(ValueError, match="not one nested growth step"):
         interpolation_neighbours(9, 2, 5)
+
+
+def test_a_schedule_saved_before_the_plateau_rule_loads_as_eq4_alone():
+    import pickle
+
+    old = AdaptiveGrowth(window=2, returns_source="training")
+    old.decide(5.0)
+    state = dict(old.__dict__)
+    for name in ("patience", "min_improvement", "level_returns"):
+        del state[name]
+    restored = AdaptiveGrowth.__new__(AdaptiveGrowth)
+    restored.__setstate__(state)
+    assert restored.patience is None and restored.level_returns == [5.0] and restored.min_improvement == 0.05
+    assert pickle.loads(pickle.dumps(old)).patience == 2  # new pickles keep their settings
