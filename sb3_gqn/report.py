@@ -2,6 +2,7 @@
 
     python -m sb3_gqn.report docs/results/*/results.csv               # tables for the README
     python -m sb3_gqn.report docs/results/*/results.csv --plots docs/results/all   # plus the cross-task IQM plot
+    python -m sb3_gqn.report docs/results/*/results.csv --algos gqn-adaptive decqn-9 decqn-2   # only these
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -120,6 +122,7 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
     }
     shown = final[list(columns)].rename(columns=columns)
     shown["env"] = shown["env"].str.replace("dm_control/", "", regex=False)
+    shown["bins"] = shown["bins"].map(lambda bins: "-" if pd.isna(bins) else str(int(bins)))
     sections.append(_markdown(shown))
 
     means = final.groupby(["env", "penalty", "algo"]).agg(
@@ -170,21 +173,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("tables", nargs="+", type=Path, help="results.csv files of the comparison runner")
     parser.add_argument("--plots", type=Path, help="also draw the suite's figures for the combined table into this folder")
     parser.add_argument("--reps", type=int, default=2000, help="bootstrap repetitions of the IQM intervals")
+    parser.add_argument("--algos", nargs="+", help="only these algorithms (also for the IQM's per-task normalization)")
     args = parser.parse_args(argv)
     missing = [str(path) for path in args.tables if not path.is_file()]
     if missing:
         print(f"sb3_gqn.report: error: no such table: {', '.join(missing)}", file=sys.stderr)
         return 2
     table = load(args.tables)
+    if args.algos:
+        table = table[table["algo"].isin(args.algos)]
     print(report(table, args.reps))
     if args.plots is not None:
         from sb3_gqn.plots import plot_suite
 
         args.plots.mkdir(parents=True, exist_ok=True)
-        combined = args.plots / "results.csv"
-        table.to_csv(combined, index=False)
-        for path in plot_suite(combined, args.plots):
-            print(f"plot: {path}")
+        with tempfile.TemporaryDirectory() as scratch:  # not in --plots: a glob over results.csv files would find it
+            combined = Path(scratch) / "results.csv"
+            table.to_csv(combined, index=False)
+            for path in plot_suite(combined, args.plots):
+                print(f"plot: {path}")
     return 0
 
 
