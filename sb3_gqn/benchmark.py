@@ -98,7 +98,6 @@ COLUMNS = [
     "wall_time",
     "growth_events",
 ]
-RUN_KEY = ("algo", "env", "penalty", "seed")
 
 
 @dataclass(frozen=True)
@@ -110,6 +109,11 @@ class RunSpec:
     penalty: float
     seed: int
     steps: int
+
+    @property
+    def key(self) -> tuple[str, str, float, int]:
+        """``(algo, env, penalty, seed)``: how ``results.csv`` identifies the run."""
+        return self.algo, self.env, float(self.penalty), self.seed
 
     @property
     def name(self) -> str:
@@ -242,11 +246,15 @@ def run(spec: RunSpec, out: Path, eval_freq: int, eval_episodes: int, threads: i
     return spec.name
 
 
+#: rows of a results.csv grouped by run key (algo, env, penalty, seed)
+RecordedRuns = dict[tuple[str, str, float, int], list[dict[str, Any]]]
+
+
 def _run_key(row: dict[str, Any]) -> tuple[str, str, float, int]:
     return str(row["algo"]), str(row["env"]), float(row["penalty"]), int(float(row["seed"]))
 
 
-def recorded_rows(table: Path) -> dict[tuple[str, str, float, int], list[dict[str, Any]]]:
+def recorded_rows(table: Path) -> RecordedRuns:
     """Rows of an existing ``results.csv`` grouped by run (algo, env, penalty, seed); empty if there is none.
 
     Committed tables are how a later session (or machine) extends a suite: a run recorded there up to its
@@ -254,20 +262,20 @@ def recorded_rows(table: Path) -> dict[tuple[str, str, float, int], list[dict[st
     """
     if not table.is_file():
         return {}
-    runs: dict[tuple[str, str, float, int], list[dict[str, Any]]] = {}
+    runs: RecordedRuns = {}
     with open(table, newline="") as handle:
         for row in csv.DictReader(handle):
             runs.setdefault(_run_key(row), []).append(row)
     return runs
 
 
-def is_recorded(spec: RunSpec, recorded: dict[tuple[str, str, float, int], list[dict[str, Any]]]) -> bool:
+def is_recorded(spec: RunSpec, recorded: RecordedRuns) -> bool:
     """Whether ``results.csv`` holds ``spec`` evaluated up to its full budget."""
-    rows = recorded.get((spec.algo, spec.env, float(spec.penalty), spec.seed), [])
+    rows = recorded.get(spec.key, [])
     return any(int(float(row["step"])) >= spec.steps for row in rows)
 
 
-def is_finished(spec: RunSpec, out: Path, recorded: dict[tuple[str, str, float, int], list[dict[str, Any]]]) -> bool:
+def is_finished(spec: RunSpec, out: Path, recorded: RecordedRuns) -> bool:
     return (out / "runs" / spec.name / "done.json").is_file() or is_recorded(spec, recorded)
 
 
@@ -283,7 +291,7 @@ def collect(specs: list[RunSpec], out: Path) -> Path:
         curve = out / "runs" / spec.name / "curve.csv"
         if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
             with open(curve, newline="") as rows:
-                rows_by_run[(spec.algo, spec.env, float(spec.penalty), spec.seed)] = list(csv.DictReader(rows))
+                rows_by_run[spec.key] = list(csv.DictReader(rows))
     with open(table.with_suffix(".csv.tmp"), "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
         writer.writeheader()
@@ -322,8 +330,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
-def _report(specs: list[RunSpec], out: Path, running: dict[str, RunSpec]) -> str:
-    recorded = recorded_rows(out / "results.csv")
+def _report(
+    specs: list[RunSpec],
+    out: Path,
+    running: dict[str, RunSpec],
+    recorded: RecordedRuns,
+) -> str:
     done = sum(is_finished(spec, out, recorded) for spec in specs)
     parts = [f"[{done}/{len(specs)} runs done]"]
     for name, spec in running.items():
@@ -370,7 +382,7 @@ def main(argv: list[str] | None = None) -> int:
                     print(f"finished {spec.name}")
                 if time.monotonic() - last_report > 15:
                     running = {spec.name: spec for spec in futures.values() if (out / "runs" / spec.name).exists()}
-                    print(_report(specs, out, running), flush=True)
+                    print(_report(specs, out, running, recorded), flush=True)
                     last_report = time.monotonic()
                 time.sleep(0.5)
     table = collect(specs, out)

@@ -353,7 +353,7 @@ class GQN(OffPolicyAlgorithm):
         if level == self.growth_level:
             return
         previous_bins = self.active_bins
-        if getattr(self, "growth_init", "none") == "interpolate":
+        if self.growth_init == "interpolate":
             # One nested step at a time, so a jump over several levels interpolates from already warm bins
             for step_level in range(self.growth_level + 1, level + 1):
                 self.policy.interpolate_bins(
@@ -361,8 +361,6 @@ class GQN(OffPolicyAlgorithm):
                 )
         self.growth_level = level
         self._apply_growth_level()
-        if not hasattr(self, "growth_events"):  # models saved before growth events were recorded
-            self.growth_events = []
         self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
         if getattr(self, "_logger", None) is not None:  # no logger before the first learn()
             self.logger.record("growth/active_bins", self.active_bins)

@@ -88,7 +88,7 @@ def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
                 (line,) = axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})")
                 axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2)
             _mark_growth_events(axes[0], runs, curve, line.get_color())
-        if any(_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
+        if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
             axes[0].plot([], [], "v", color="grey", label="growth (new bin count)")
         axes[0].set_xlabel("environment steps")
         axes[1].set_xlabel("training wall time [s]")
@@ -103,7 +103,7 @@ def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
     return paths
 
 
-def _growth_events(runs: pd.DataFrame) -> list[tuple[int, int]]:
+def run_growth_events(runs: pd.DataFrame) -> list[tuple[int, int]]:
     """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row."""
     if "growth_events" not in runs or runs.empty:
         return []
@@ -116,7 +116,7 @@ def _growth_events(runs: pd.DataFrame) -> list[tuple[int, int]]:
 def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
     """A triangle on the algorithm's mean curve at every growth of each of its seeds, labelled with the new bins."""
     for _, run in runs.groupby("seed"):
-        for step, bins in _growth_events(run):
+        for step, bins in run_growth_events(run):
             value = float(np.interp(step, curve.index.to_numpy(), curve["mean"].to_numpy()))
             axis.plot([step], [value], "v", color=color, markersize=6, markeredgecolor="black", markeredgewidth=0.5)
             axis.annotate(str(bins), (step, value), textcoords="offset points", xytext=(0, 6), fontsize=6, ha="center")

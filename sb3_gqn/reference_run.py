@@ -84,9 +84,7 @@ def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
         writer.writerows(rows)
 
 
-def plot_learning_curve(
-    path: Path, rows: list[dict[str, Any]], title: str, growth_events: list[tuple[int, int]] | None = None
-) -> None:
+def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str, growth_events: list[tuple[int, int]]) -> None:
     """Greedy return and task return over env steps; a dotted line at every growth event."""
     import matplotlib
 
@@ -97,12 +95,6 @@ def plot_learning_curve(
     figure, axis = plt.subplots(figsize=(6.4, 4.0))
     axis.plot(steps, [row["return_mean"] for row in rows], marker="o", label="return (penalized)")
     axis.plot(steps, [row["task_return_mean"] for row in rows], marker=".", linestyle="--", label="task return")
-    if growth_events is None:  # no exact record: mark where an evaluation first saw a new bin count
-        growth_events, previous_bins = [], None
-        for row in rows:
-            if row["active_bins"] is not None and row["active_bins"] != previous_bins and previous_bins is not None:
-                growth_events.append((row["step"], row["active_bins"]))
-            previous_bins = row["active_bins"]
     for step, bins in growth_events:
         axis.axvline(step, color="grey", alpha=0.4, linestyle=":")
         axis.annotate(f"-> {bins} bins", (step, axis.get_ylim()[0]), rotation=90, fontsize=7, va="bottom")

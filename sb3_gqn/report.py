@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from sb3_gqn.plots import _growth_events, final_rows, iqm_with_intervals, normalized_final_scores
+from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores, run_growth_events
 
 
 def held_after_growth(before: float, after: float) -> bool:
@@ -63,7 +63,7 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
     for (algo, env, _, seed), run in table.groupby(["algo", "env", "penalty", "seed"]):
         run = run.sort_values("step")
         steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
-        for step, bins in _growth_events(run):
+        for step, bins in run_growth_events(run):
             earlier, later = np.flatnonzero(steps <= step), np.flatnonzero(steps > step)
             checks.append(
                 GrowthCheck(
