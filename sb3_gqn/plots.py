@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -164,9 +165,18 @@ def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
         low, high = intervals[algo][:, 0]
         axis.barh(row, high - low, left=low, height=0.6, alpha=0.6)
         axis.plot([estimates[algo][0]] * 2, [row - 0.3, row + 0.3], color="black")
+        runs = int(scores[algo].shape[0])
+        if runs == 1:  # one run per task: no interval to draw, say so instead of showing an empty row
+            axis.annotate(
+                "1 run per task: no CI", (high, row), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7
+            )
+    lows = [intervals[algo][0, 0] for algo in algos]
+    highs = [intervals[algo][1, 0] for algo in algos]
+    axis.set_xlim(min(lows) - 0.05, max(highs) + 0.2)  # room for the estimate at an interval's edge and the note
     axis.set_yticks(range(len(algos)), algos)
     axis.set_xlabel("IQM of normalized final return (95 % bootstrap CI)")
-    axis.set_title(f"{len(tasks)} task(s): " + ", ".join(f"{env} c={c:g}" for env, c in tasks), fontsize=8)
+    names = [f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks]
+    axis.set_title(f"{len(tasks)} task(s): " + textwrap.fill(", ".join(names), 90), fontsize=8)
     figure.tight_layout()
     path = out / "aggregate_iqm.png"
     figure.savefig(path, dpi=110)
