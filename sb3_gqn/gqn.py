@@ -394,7 +394,7 @@ class GQN(OffPolicyAlgorithm):
             indices = self._active_bin_indices[np.random.randint(len(self._active_bin_indices), size=shape)]
         else:
             greedy_rows = self.growth_schedule.greedy_envs if self.growth_schedule is not None else None
-            greedy, _ = self.policy.predict(self._last_obs, deterministic=True)  # type: ignore[arg-type]
+            greedy = self.policy.act(self._last_obs)  # type: ignore[arg-type]
             indices = epsilon_greedy(
                 greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows, exploration=self.exploration
             )

@@ -8,6 +8,7 @@ import numpy as np
 import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.policies import BasePolicy
+from stable_baselines3.common.preprocessing import is_image_space
 from stable_baselines3.common.torch_layers import (
     BaseFeaturesExtractor,
     CombinedExtractor,
@@ -18,6 +19,9 @@ from stable_baselines3.common.type_aliases import PyTorchObs, Schedule
 from torch import nn
 
 from sb3_gqn.masking import masked_argmax
+
+# Layers whose output depends on ``module.training`` (SB3's own policies switch modes for these).
+_MODE_DEPENDENT_LAYERS = (nn.modules.dropout._DropoutNd, nn.modules.batchnorm._NormBase)
 
 
 def decoupled_action_shape(action_space: spaces.Space) -> tuple[int, int]:
@@ -85,7 +89,12 @@ class DecoupledMLP(nn.Module):
     def forward(self, features: th.Tensor) -> th.Tensor:
         hidden = features
         for block, skip in zip(self.blocks, self.skips, strict=True):
-            hidden = hidden + block(hidden) if skip else block(hidden)
+            output = hidden
+            # Each layer's ``forward`` directly: at batch 1 the module-call machinery (hook dispatch) costs about as
+            # much as the matmuls themselves (sb3-gqn adds no hooks; ``register_forward_hook`` on layers is not run).
+            for layer in block:
+                output = layer.forward(output)
+            hidden = hidden + output if skip else output
         return hidden
 
 
@@ -132,11 +141,23 @@ class DecoupledQNetwork(BasePolicy):
         self.action_dims, self.max_bins = decoupled_action_shape(action_space)
         self.torso = DecoupledMLP(features_dim, self.net_arch, activation_fn, layer_norm, residual)
         self.head = nn.Linear(self.torso.output_dim, self.action_dims * self.max_bins)
+        # A flat vector observation needs no preprocessing beyond float() and flatten (SB3's preprocess_obs and
+        # FlattenExtractor do exactly that), so the forward pass skips their calls.
+        self.flat_vector_observations = (
+            type(features_extractor) is FlattenExtractor
+            and isinstance(observation_space, spaces.Box)
+            and not (normalize_images and is_image_space(observation_space))
+        )
 
     def forward(self, obs: PyTorchObs) -> th.Tensor:
         """Utilities ``Q^j(s, a^j)`` of shape ``(batch, action_dims, max_bins)``."""
-        features = self.extract_features(obs, self.features_extractor)
-        return self.head(self.torso(features)).view(-1, self.action_dims, self.max_bins)
+        if self.flat_vector_observations:
+            features = obs.float()  # type: ignore[union-attr]
+            if features.dim() > 2:
+                features = features.flatten(1)
+        else:
+            features = self.extract_features(obs, self.features_extractor)
+        return self.head.forward(self.torso.forward(features)).view(-1, self.action_dims, self.max_bins)
 
     def _predict(self, observation: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         # Unmasked greedy bins; GQNPolicy applies the active-bin mask.
@@ -213,6 +234,7 @@ class GQNPolicy(BasePolicy):
         self.layer_norm = layer_norm
         self.residual = residual
         self.action_dims, self.max_bins = decoupled_action_shape(action_space)
+        self._discrete_actions = isinstance(action_space, spaces.Discrete)  # one dimension, actions without a last axis
         self.register_buffer("active_bins_mask", th.ones(self.max_bins, dtype=th.bool))
         self.net_args = {
             "observation_space": self.observation_space,
@@ -230,6 +252,7 @@ class GQNPolicy(BasePolicy):
         self.q_net_target = self.make_q_net()
         self.q_net_target.load_state_dict(self.q_net.state_dict())
         self.q_net_target.set_training_mode(False)
+        self._mode_dependent = any(isinstance(module, _MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
         # Only the online network is optimized (the target net's parameters stay out of the optimizer)
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.q_net.parameters(),
@@ -269,8 +292,8 @@ class GQNPolicy(BasePolicy):
 
     def _predict(self, obs: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         """Greedy bin per dimension over the active set (paper eq. 3); shape ``(batch, action_dims)``."""
-        actions = masked_argmax(self.q_net(obs), self.active_bins_mask)
-        if isinstance(self.action_space, spaces.Discrete):
+        actions = masked_argmax(self.q_net.forward(obs), self.active_bins_mask)
+        if self._discrete_actions:
             return actions.squeeze(-1)
         return actions
 
@@ -294,12 +317,90 @@ class GQNPolicy(BasePolicy):
     def set_training_mode(self, mode: bool) -> None:
         """Put the online network in training or evaluation mode (the target stays in eval mode).
 
-        SB3 calls this before every ``predict``; walking the module tree each env step costs ~0.2 ms,
-        so it only happens when the mode actually changes.
+        SB3 switches modes around every rollout and every ``train`` call. Walking the module tree costs ~0.1 ms, so it
+        only happens when the mode changes and the network has layers that depend on it (:attr:`mode_dependent`);
+        otherwise only the policy's and the online network's own flags change.
         """
         if self.q_net.training != mode or self.training != mode:
-            self.q_net.set_training_mode(mode)
+            if self._mode_dependent:
+                self.q_net.set_training_mode(mode)
+            else:
+                self.q_net.training = mode
             self.training = mode
+
+    @property
+    def device(self) -> th.device:
+        """The networks' device, read from the mask buffer (SB3's property iterates over the parameters: ~5 us a call,
+        paid on every env step)."""
+        mask = self._buffers.get("active_bins_mask")
+        return super().device if mask is None else mask.device
+
+    @property
+    def mode_dependent(self) -> bool:
+        """Whether the online network computes something else in training mode (dropout, batch norm).
+
+        Only then do :meth:`act` and :meth:`predict` switch it to evaluation mode: with the default layers the
+        switch would change nothing but cost a module-tree walk every env step (and another one back in ``train``).
+        """
+        return self._mode_dependent
+
+    def act(self, observation: np.ndarray | dict[str, np.ndarray]) -> np.ndarray:
+        """The lean acting path: greedy bins over the active set for a batch of observations.
+
+        ``observation`` is batched as a VecEnv returns it (``(n_envs, *obs_shape)``, or a dict of such arrays);
+        the result has shape ``(n_envs, *action_space.shape)``, exactly what :meth:`predict` returns for it, without
+        SB3's per-call work that does not apply here (unbatched-input detection, Box clipping, autograd bookkeeping).
+        Training (:meth:`~sb3_gqn.GQN._sample_action`) acts through it; :meth:`predict` shares its last step.
+        """
+        mask = self.active_bins_mask  # module attributes are looked up once: each lookup costs ~0.4 us here
+        q_net = self.q_net
+        if isinstance(observation, dict):
+            obs_tensor: PyTorchObs = {key: th.as_tensor(value, device=mask.device) for key, value in observation.items()}
+        elif q_net.flat_vector_observations:
+            obs_tensor = th.as_tensor(observation, dtype=th.float32, device=mask.device)  # the network's float() in one step
+        else:
+            obs_tensor = th.as_tensor(observation, device=mask.device)
+        return self._greedy_bins(q_net, obs_tensor, mask)
+
+    def _greedy_bins(self, q_net: DecoupledQNetwork, obs_tensor: PyTorchObs, mask: th.Tensor) -> np.ndarray:
+        """Paper eq. 3's greedy bins as a NumPy array ``(batch, *action_space.shape)``, in evaluation mode."""
+        if self._mode_dependent:
+            self.set_training_mode(False)
+        with th.inference_mode():
+            bins = masked_argmax(q_net.forward(obs_tensor), mask)
+        if self._discrete_actions:
+            bins = bins.squeeze(-1)
+        return bins.cpu().numpy()
+
+    def predict(
+        self,
+        observation: np.ndarray | dict[str, np.ndarray],
+        state: tuple[np.ndarray, ...] | None = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = False,
+    ) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:
+        """Greedy bins over the active set (SB3's ``predict``: one or a batch of observations).
+
+        The policy is always greedy (exploration lives in :class:`~sb3_gqn.GQN`), so ``deterministic`` changes
+        nothing. SB3's conversion of the observation (batch dimension, image transposition) is kept; the rest goes
+        through :meth:`act`.
+
+        :param observation: the input observation
+        :param state: returned unchanged (no recurrent state)
+        :param episode_start: unused (no recurrent state)
+        :param deterministic: unused (always greedy)
+        :return: bin indices and ``state``
+        """
+        if isinstance(observation, tuple) and len(observation) == 2 and isinstance(observation[1], dict):
+            raise ValueError(
+                "You have passed a tuple to predict() instead of a Numpy array or a Dict: `obs, info = env.reset()` "
+                "(Gym API) vs `obs = vec_env.reset()` (SB3 VecEnv API)"
+            )
+        obs_tensor, vectorized_env = self.obs_to_tensor(observation)
+        actions = self._greedy_bins(self.q_net, obs_tensor, self.active_bins_mask)
+        if not vectorized_env:
+            actions = actions.squeeze(axis=0)
+        return actions, state
 
 
 MlpPolicy = GQNPolicy

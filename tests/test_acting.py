@@ -1,0 +1,82 @@
+"""The lean acting path (GQNPolicy.act) against SB3's predict, and train/eval modes."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch as th
+from gymnasium import spaces
+from stable_baselines3.common.policies import BasePolicy
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from torch import nn
+
+from sb3_gqn import GQN
+from tests.envs import DecliningEnv
+
+
+def batch_of(space: spaces.Space, count: int = 64):
+    space.seed(0)
+    samples = [space.sample() for _ in range(count)]
+    if isinstance(space, spaces.Dict):
+        return {key: np.stack([sample[key] for sample in samples]) for key in space.spaces}
+    return np.stack(samples)
+
+
+@pytest.mark.parametrize(
+    ("make_model", "action_shape"),
+    [
+        (lambda: GQN("MlpPolicy", "CartPole-v1", bins=2, seed=0), ()),  # Discrete: no action axis
+        (lambda: GQN("MlpPolicy", "Pendulum-v1", seed=0), (1,)),
+        (lambda: GQN("MlpPolicy", DecliningEnv(action_dims=3), seed=0), (3,)),
+        (
+            lambda: GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, prioritized_replay=False, seed=0),
+            (2,),
+        ),
+    ],
+)
+def test_act_equals_sb3_predict_for_a_batch(make_model, action_shape):
+    model = make_model()
+    if len(model.bin_levels) > 1:
+        model.grow(1)  # a partial mask: 3 of 9 bins
+    batch = batch_of(model.observation_space)
+    sb3_actions, _ = BasePolicy.predict(model.policy, batch, deterministic=True)
+    actions = model.policy.act(batch)
+    assert actions.shape == (64, *action_shape)
+    np.testing.assert_array_equal(actions, sb3_actions)
+    np.testing.assert_array_equal(model.policy.predict(batch)[0], sb3_actions)
+    single, _ = model.policy.predict(batch[0] if not isinstance(batch, dict) else {k: v[0] for k, v in batch.items()})
+    np.testing.assert_array_equal(single, sb3_actions[0])  # an unbatched observation gives an unbatched action
+
+
+class DropoutExtractor(BaseFeaturesExtractor):
+    def __init__(self, observation_space: spaces.Box):
+        super().__init__(observation_space, features_dim=16)
+        self.net = nn.Sequential(nn.Flatten(), nn.Linear(int(np.prod(observation_space.shape)), 16), nn.Dropout(0.5))
+
+    def forward(self, observations: th.Tensor) -> th.Tensor:
+        return self.net(observations)
+
+
+def test_mode_is_switched_only_for_layers_that_depend_on_it():
+    plain = GQN("MlpPolicy", "Pendulum-v1", seed=0)
+    assert not plain.policy.mode_dependent
+    with_dropout = GQN(
+        "MlpPolicy", "Pendulum-v1", policy_kwargs=dict(features_extractor_class=DropoutExtractor), learning_starts=50, seed=0
+    )
+    assert with_dropout.policy.mode_dependent
+    dropout = with_dropout.q_net.features_extractor.net[2]
+    batch = batch_of(with_dropout.observation_space, 256)
+    with_dropout.policy.set_training_mode(True)
+    first = with_dropout.policy.act(batch)
+    assert not dropout.training  # act put the network in evaluation mode: dropout off, the same action every call
+    np.testing.assert_array_equal(first, with_dropout.policy.act(batch))
+    with_dropout.learn(100)  # train() switches it back for the updates
+    with_dropout.train(gradient_steps=1, batch_size=32)
+    assert dropout.training and with_dropout.q_net.training
+
+
+def test_plain_networks_skip_the_module_tree_walk():
+    model = GQN("MlpPolicy", gym.make("Pendulum-v1"), seed=0)
+    layer = model.q_net.torso.blocks[0][0]
+    model.policy.set_training_mode(False)
+    assert not model.policy.training and not model.q_net.training
+    assert layer.training  # nothing below the online network's own flag is touched: no layer reads it
