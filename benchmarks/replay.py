@@ -5,8 +5,8 @@
 
 Buffers hold humanoid-sized transitions (67-dimensional float32 observations, 21 action dimensions
 of 9 bins) and are filled to 10^4, 10^5 and 10^6 transitions with random priorities. It prints
-milliseconds per ``sample(256)`` of SB3's ``NStepReplayBuffer`` and of
-:class:`~sb3_gqn.buffers.PrioritizedReplayBuffer`, per ``update_priorities(256)``, their ratio, the
+milliseconds per sample(256) of SB3's NStepReplayBuffer and of
+sb3_gqn.buffers.PrioritizedReplayBuffer, per update_priorities(256), their ratio, the
 bytes per stored transition, and the PER overhead relative to one GQN gradient step (512x512 MLP,
 batch 256) measured on the same data. With cpprb installed it also times cpprb's C++ prioritized
 buffer (its own storage, not SB3's) for reference.

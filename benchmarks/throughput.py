@@ -4,14 +4,14 @@
     python benchmarks/throughput.py --rounds 3       # quicker, noisier
 
 1. The CPU's matmul peak (GFLOP/s of a 512x512x512 float32 matmul with torch's threads).
-2. Gradient steps (MLP 512x512, batch 256, prioritized 3-step replay, ``train(1)`` as the main job calls it) on
+2. Gradient steps (MLP 512x512, batch 256, prioritized 3-step replay, train(1) as the main job calls it) on
    cartpole-swingup (5-dim observations, 1x9 utilities) and humanoid-walk (67-dim, 21x9): ms per update against
-   the FLOP-bound time, 5 forward-pass equivalents (online forward and backward on ``obs``, online and target
-   forward on ``next_obs``) at the measured peak. Peak and update are measured alternately, ``--rounds`` times,
+   the FLOP-bound time, 5 forward-pass equivalents (online forward and backward on obs, online and target
+   forward on next_obs) at the measured peak. Peak and update are measured alternately, --rounds times,
    and the median ratio is reported: the machine's speed drifts.
 3. Acting at batch 1 (cartpole-swingup): the bare three matmuls and argmax, the lean path
-   (``GQNPolicy.act``), ``GQN.predict`` (env action) and SB3's ``BasePolicy.predict`` on the same policy.
-4. The exported policy (``sb3_gqn.export``) at batch 1: TorchScript and ONNX Runtime, next to ``predict``.
+   (GQNPolicy.act), GQN.predict (env action) and SB3's BasePolicy.predict on the same policy.
+4. The exported policy (sb3_gqn.export) at batch 1: TorchScript and ONNX Runtime, next to predict.
 5. Env steps/s while training: the main job's configuration (GQN, 1 update per 2 env steps, cartpole-swingup,
    c = 0.1) against SB3's SAC with its defaults on the same env, and GQN against DQN on CartPole.
 Numbers are only comparable within one run.

@@ -1,25 +1,26 @@
 """Comparison suite: GQN vs DecQN vs SAC/TD3 on penalized envs, in parallel, resumable, one tidy table and plots.
 
-    python -m sb3_gqn.benchmark                       # short suite: Pendulum-v1, c = 0.1 (~10 min on 2 cores)
+    python -m sb3_gqn.benchmark                       # short suite: Pendulum-v1, c = 0.1 (~3 min on 2 cores)
     python -m sb3_gqn.benchmark --algos gqn-adaptive sac --envs dm_control/cartpole-swingup-v0 \\
         --penalties 0.1 --seeds 0 1 --steps 100000 --out results/cartpole
     python -m sb3_gqn.benchmark --full --list         # the paper-scale suite (list the runs only)
 
-Each run trains through the project's rl-zoo3 integration (``ExperimentManager`` with the shipped
-hyperparameter file of its algorithm, the penalty set in the entry's ``ActionPenalty`` wrapper and the
-budget given here), evaluates greedily every ``--eval-freq`` steps with :func:`~sb3_gqn.metrics.rollout_figures`
-and writes ``<out>/runs/<run>/curve.csv``; ``done.json`` marks it finished. Runs go to parallel
-processes (``--jobs``, default the core count, torch threads split between them). A second invocation
-skips finished runs (a ``done.json``, or the run's rows up to its budget in ``<out>/results.csv``, so a
+Each run trains through the project's rl-zoo3 integration (ExperimentManager with the shipped
+hyperparameter file of its algorithm, the penalty set in the entry's ActionPenalty wrapper and the
+budget given here), evaluates greedily every --eval-freq steps with sb3_gqn.metrics.rollout_figures
+and writes <out>/runs/<run>/curve.csv; done.json marks it finished. Runs go to parallel
+processes (--jobs, default the core count, torch threads split between them). A second invocation
+skips finished runs (a done.json, or the run's rows up to its budget in <out>/results.csv, so a
 committed table can be extended by a later session) and restarts interrupted ones from scratch. At the
-end ``<out>/results.csv`` holds every evaluation of every run of the suite (algo, env, penalty, seed, step,
-return, task return, wall time, smoothness figures, growth events) and :mod:`sb3_gqn.plots` draws the figures into ``<out>/``.
+end <out>/results.csv holds every evaluation of every run of the suite (algo, env, penalty, seed, step,
+return, task return, wall time, smoothness figures, growth events) and sb3_gqn.plots draws the figures into <out>/.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import inspect
 import json
 import os
 import shutil
@@ -126,6 +127,33 @@ def penalized_wrappers(env_wrapper: Any, penalty: float) -> list[Any]:
     name = "sb3_gqn.wrappers.ActionPenalty"
     kept = [w for w in wrappers if not (w == name or (isinstance(w, dict) and name in w))]
     return [*kept, {name: {"coef": float(penalty)}}]
+
+
+def learning_starts(spec: RunSpec) -> int:
+    """Steps of random actions before a run's first gradient step (its entry's value, else the class default)."""
+    zoo_algo, overrides = VARIANTS[spec.algo]
+    entry = {**_shipped_entry(zoo_algo, spec.env), **overrides}
+    if "learning_starts" in entry:
+        return int(entry["learning_starts"])
+    from stable_baselines3 import SAC, TD3
+
+    from sb3_gqn import GQN
+
+    algorithm = {"gqn": GQN, "decqn": GQN, "sac": SAC, "td3": TD3}[zoo_algo]  # DecQN passes its kwargs to GQN
+    return int(inspect.signature(algorithm).parameters["learning_starts"].default)
+
+
+def untrained_runs(specs: list[RunSpec]) -> list[str]:
+    """One warning per algorithm and env whose budget does not exceed its ``learning_starts``: such runs never
+    train, and their rows look like a result."""
+    warnings = {}
+    for spec in specs:
+        starts = learning_starts(spec)
+        if spec.steps <= starts:
+            warnings[(spec.algo, spec.env)] = (
+                f"NO LEARNING: {spec.algo} on {spec.env} has a budget of {spec.steps} steps <= its learning_starts={starts}"
+            )
+    return list(warnings.values())
 
 
 def _shipped_entry(zoo_algo: str, env_id: str) -> dict[str, Any]:
@@ -362,6 +390,9 @@ def main(argv: list[str] | None = None) -> int:
     recorded = recorded_rows(out / "results.csv")
     pending = [spec for spec in specs if not is_finished(spec, out, recorded)]
     print(f"{len(specs)} runs, {len(specs) - len(pending)} already finished, {len(pending)} to train -> {out}")
+    warnings = untrained_runs(specs)
+    for warning in warnings:
+        print(f"WARNING: {warning}: raise --steps", file=sys.stderr)
     if args.list:
         for spec in specs:
             print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
@@ -390,7 +421,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_plots:
         from sb3_gqn.plots import plot_suite
 
-        for path in plot_suite(table, out):
+        for path in plot_suite(table, out, warnings):
             print(f"plot: {path}")
     return 0
 

@@ -11,6 +11,7 @@ from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
 from stable_baselines3.common.vec_env import VecNormalize
 
+from sb3_gqn.arguments import check_int, check_number
 from sb3_gqn.sum_tree import SumTree, check_priorities
 
 # The per-(row, env) arrays of SB3's ReplayBuffer; an env's column of each is a view of it.
@@ -89,6 +90,9 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
                 "PrioritizedReplayBuffer does not support optimize_memory_usage=True (neither does SB3's "
                 "NStepReplayBuffer it builds on)"
             )
+        check_int("buffer_size", buffer_size, 1)
+        check_int("n_steps", n_steps, 1)
+        check_number("gamma", gamma, 0.0, 1.0, low_open=True)
         if not alpha >= 0:
             raise ValueError(f"alpha (priority exponent) must be >= 0, got {alpha}")
         if not epsilon > 0:

@@ -74,11 +74,16 @@ def save_q_snapshot(run_dir: Path) -> QValueSnapshots:
     return QValueSnapshots(run_dir)
 
 
-def learning_curves(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band."""
+def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None = None) -> list[Path]:
+    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band.
+
+    ``warnings`` (e.g. runs whose budget never reached ``learning_starts``) are printed in red on every figure.
+    """
     paths = []
     for (env, penalty), task in table.groupby(["env", "penalty"]):
         figure, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for index, warning in enumerate(warnings or []):
+            figure.text(0.5, 0.5 - 0.06 * index, warning, color="red", ha="center", fontsize=9, wrap=True)
         for algo, runs in task.groupby("algo"):
             curve = runs.groupby("step").agg(
                 mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "mean")
@@ -251,12 +256,12 @@ def q_value_picture(run_dir: Path, out: Path) -> Path | None:
     return path
 
 
-def plot_suite(table_path: Path, out: Path) -> list[Path]:
-    """All figures for a results table; returns the written paths."""
+def plot_suite(table_path: Path, out: Path, warnings: list[str] | None = None) -> list[Path]:
+    """All figures for a results table; returns the written paths (``warnings``: see :func:`learning_curves`)."""
     table = pd.read_csv(table_path)
     if table.empty:
         return []
-    paths = [*learning_curves(table, out), aggregate(table, out), *smoothness_radar(table, out)]
+    paths = [*learning_curves(table, out, warnings), aggregate(table, out), *smoothness_radar(table, out)]
     for run_dir in sorted((out / "runs").glob("*")):
         picture = q_value_picture(run_dir, out)
         if picture is not None:

@@ -3,9 +3,9 @@
     python -m sb3_gqn.reference_run                       # cartpole-swingup, c = 0.1, sb3_gqn/hyperparams/gqn.yml
     python -m sb3_gqn.reference_run --timesteps 20000 --out /tmp/smoke
 
-Writes to ``<out>/<run name>/``: ``learning_curve.csv`` (greedy evaluation every ``--eval-freq``
-steps: return, task return, penalty, active bins, training wall time), ``learning_curve.png``,
-``final_evaluation.json`` and the trained ``model.zip``.
+Writes to <out>/<run name>/: learning_curve.csv (greedy evaluation every --eval-freq
+steps: return, task return, penalty, active bins, training wall time), learning_curve.png,
+final_evaluation.json and the trained model.zip.
 """
 
 from __future__ import annotations

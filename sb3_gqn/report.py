@@ -1,4 +1,4 @@
-"""Markdown tables and the growth checks from one or more comparison-suite ``results.csv`` files.
+"""Markdown tables and the growth checks from one or more comparison-suite results.csv files.
 
     python -m sb3_gqn.report docs/results/*/results.csv               # tables for the README
     python -m sb3_gqn.report docs/results/*/results.csv --plots docs/results/all   # plus the cross-task IQM plot
@@ -9,7 +9,7 @@ Prints, from the tables alone (no model files needed, so committed tables are en
 * the final greedy evaluation of every run (return, task return, P, |Δa|, SM, bins, training seconds);
 * per algorithm and task, the mean final return and SM over seeds;
 * the growth check of every GQN run: for each growth event, the last evaluation before it and the first
-  after it, and whether the return held (:func:`held_after_growth`);
+  after it, and whether the return held (held_after_growth);
 * rliable's IQM of min-max normalized final returns across the tasks, with 95 % bootstrap intervals.
 """
 

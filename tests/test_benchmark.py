@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import csv
+import importlib
+import re
 
 import pytest
 
-from sb3_gqn.benchmark import COLUMNS, RunSpec, main, parse_args, penalized_wrappers
+from sb3_gqn.benchmark import COLUMNS, RunSpec, learning_starts, main, parse_args, penalized_wrappers, untrained_runs
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
@@ -40,9 +42,30 @@ def test_suites_and_bad_env(capsys):
     assert "NoSuchEnv-v0" in capsys.readouterr().err
 
 
+def test_budgets_that_never_reach_learning_starts_are_flagged():
+    # gqn-linear: the class default (the Pendulum entry sets none); sac: the entry's learning_starts
+    assert learning_starts(RunSpec("gqn-linear", "Pendulum-v1", 0.1, 0, 400)) == 1000
+    assert learning_starts(RunSpec("sac", "Pendulum-v1", 0.1, 0, 400)) == 1000
+    specs = [
+        RunSpec(algo, "Pendulum-v1", 0.1, seed, steps)
+        for algo in ("gqn-linear", "sac")
+        for seed in (0, 1)
+        for steps in (1000,)
+    ]
+    assert untrained_runs(specs) == [
+        f"NO LEARNING: {algo} on Pendulum-v1 has a budget of 1000 steps <= its learning_starts=1000"
+        for algo in ("gqn-linear", "sac")
+    ]  # one warning per algorithm and env, not per seed
+    assert untrained_runs([RunSpec("gqn-linear", "Pendulum-v1", 0.1, 0, 1001)]) == []
+
+
 def test_tiny_suite_end_to_end_and_resume(tmp_path, capsys):
     out = tmp_path / "suite"
     assert main(["--algos", "gqn-linear", "sac", *TINY, "--out", str(out)]) == 0
+    # 400 steps never reach learning_starts: the runner says so loudly (and the learning-curve plot in red)
+    assert "WARNING: NO LEARNING: sac on Pendulum-v1 has a budget of 400 steps <= its learning_starts=1000" in (
+        capsys.readouterr().err
+    )
     with open(out / "results.csv", newline="") as handle:
         reader = csv.DictReader(handle)
         rows = list(reader)
@@ -117,3 +140,12 @@ def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
                 "gqn-before+shared": {"exploration"},
             }[name]
         )
+
+
+@pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])
+def test_help_texts_are_plain_text(module, capsys):
+    entry_point = importlib.import_module(module).main
+    with pytest.raises(SystemExit):
+        entry_point(["--help"])
+    text = capsys.readouterr().out
+    assert "usage:" in text and "``" not in text and not re.search(r":(func|mod|class|meth):", text)

@@ -87,6 +87,7 @@ def models() -> dict[str, tuple[GQN, spaces.Space]]:
                 ObservationEnv(IMAGE_SPACE),
                 "CnnPolicy",
                 buffer_size=100,
+                batch_size=32,
                 policy_kwargs=dict(net_arch=[64], features_extractor_kwargs=dict(features_dim=64)),
             ),
             IMAGE_SPACE,

@@ -67,7 +67,7 @@ def test_converter_reproduces_the_sampler():
             trial = study.ask()
             sampled = sampler(trial, 1, 1, {})
             assert convert_gqn_params(dict(trial.params)) == sampled
-            GQN("MlpPolicy", "Pendulum-v1", buffer_size=10, **sampled)  # every sample builds
+            GQN("MlpPolicy", "Pendulum-v1", buffer_size=512, **sampled)  # every sample builds
             study.tell(trial, 0.0)
     params = {
         "learning_rate": 3e-4,

@@ -1,0 +1,76 @@
+"""Constructor argument checks: a bad value fails when the model is built, naming the argument, the value
+and the valid range, instead of deep inside SB3, NumPy or torch at the first gradient step."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from typing import Any
+
+import numpy as np
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_int(name: str, value: Any, minimum: int, special: Iterable[int] = ()) -> int:
+    """``value`` as an int ``>= minimum`` (or one of ``special``, e.g. ``-1``); ``ValueError`` otherwise."""
+    if _is_int(value) and (value >= minimum or value in special):
+        return int(value)
+    extra = "".join(f" or {item}" for item in special)
+    raise ValueError(f"{name} must be an integer >= {minimum}{extra}, got {value!r}")
+
+
+def check_number(
+    name: str,
+    value: Any,
+    low: float = -math.inf,
+    high: float = math.inf,
+    low_open: bool = False,
+    high_open: bool = False,
+) -> float:
+    """``value`` as a finite float in the interval from ``low`` to ``high`` (open at the ends marked so)."""
+    if _is_number(value) and math.isfinite(value):
+        above = value > low if low_open else value >= low
+        below = value < high if high_open else value <= high
+        if above and below:
+            return float(value)
+    opening = "(" if low_open or low == -math.inf else "["
+    closing = ")" if high_open or high == math.inf else "]"
+    interval = f"{opening}{low:g}, {high:g}{closing}"
+    raise ValueError(f"{name} must be a finite number in {interval}, got {value!r}")
+
+
+def check_learning_rate(value: Any) -> float | Callable[[float], float]:
+    """A positive finite learning rate, or a schedule (a callable of the remaining progress, SB3's convention)."""
+    if callable(value):
+        return value
+    if _is_number(value) and math.isfinite(value) and value > 0:
+        return float(value)
+    raise ValueError(f"learning_rate must be a finite number > 0 or a schedule (callable), got {value!r}")
+
+
+def check_train_freq(value: Any) -> None:
+    """``train_freq``: an int >= 1, or ``(int >= 1, "step" | "episode")`` as SB3 accepts it."""
+    if isinstance(value, (tuple, list)):
+        valid = len(value) == 2 and _is_int(value[0]) and value[0] >= 1 and value[1] in ("step", "episode")
+    else:
+        valid = _is_int(value) and value >= 1
+    if not valid:
+        raise ValueError(f'train_freq must be an integer >= 1 or a pair (integer >= 1, "step" or "episode"), got {value!r}')
+
+
+def check_replay_sizes(buffer_size: int, batch_size: int, n_steps: int) -> None:
+    """The buffer must hold a whole batch and more than one n-step window."""
+    if buffer_size < batch_size:
+        raise ValueError(
+            f"buffer_size={buffer_size} is smaller than batch_size={batch_size}: every batch would repeat transitions; "
+            f"use buffer_size >= batch_size"
+        )
+    if buffer_size <= n_steps:
+        raise ValueError(f"buffer_size={buffer_size} must exceed n_steps={n_steps} to hold an n-step return")
