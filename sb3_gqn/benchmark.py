@@ -47,6 +47,7 @@ BEFORE_GROWTH_FIXES: dict[str, Any] = {
     "growth_eval_freq": 5_000,
     "exploration": "per_dimension",
 }
+REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
 #: Algorithm variants: (rl-zoo3 algorithm, hyperparameter overrides on its shipped file)
 VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-adaptive": ("gqn", {"growth": "adaptive"}),
@@ -60,6 +61,9 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-before+warm-start": ("gqn", {**BEFORE_GROWTH_FIXES, "growth_init": "interpolate"}),
     "gqn-before+plateau": ("gqn", {**BEFORE_GROWTH_FIXES, "growth_patience": 2, "growth_eval_freq": 2_500}),
     "gqn-before+shared": ("gqn", {**BEFORE_GROWTH_FIXES, "exploration": "shared"}),
+    # DecQN's reference torso (Acme's LayerNormMLP): Linear -> LayerNorm -> tanh, then ELU layers
+    "gqn-adaptive+layernorm": ("gqn", {"growth": "adaptive", "policy_kwargs": REFERENCE_TORSO}),
+    "decqn-9+layernorm": ("decqn", {"bins": 9, "policy_kwargs": REFERENCE_TORSO}),
 }
 ABLATION = ["gqn-before", "gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared", "gqn-adaptive"]
 SHORT_SUITE = dict(

@@ -12,6 +12,9 @@ from stable_baselines3.common.vec_env import VecEnv
 
 from sb3_gqn.wrappers import ActionPenalty, check_finite_box
 
+#: Meta-World v3 tasks registered as ``sb3_gqn/metaworld-<task>`` (500-step episodes) when sb3_gqn is imported
+METAWORLD_TASKS = ("reach-v3", "push-v3", "pick-place-v3", "door-open-v3", "drawer-open-v3", "button-press-topdown-v3")
+
 # Env id prefixes whose suites register their envs on import.
 SUITE_MODULES = {
     "dm_control/": "shimmy",
@@ -76,3 +79,23 @@ def check_action_space(action_space: spaces.Space) -> None:
             f"GQN supports Box (discretized), Discrete and MultiDiscrete action spaces, "
             f"got {type(action_space).__name__}: {action_space}"
         )
+
+
+def make_metaworld(env_name: str = "reach-v3", **kwargs: Any) -> gym.Env:
+    """Meta-World v3's single-task benchmark env ``Meta-World/MT1`` for ``env_name`` (500-step episodes)."""
+    import metaworld  # noqa: F401  (registers the Meta-World/ ids)
+
+    return gym.make("Meta-World/MT1", env_name=env_name, **kwargs)
+
+
+def register_project_envs() -> None:
+    """Register the project's own env ids, ``sb3_gqn/metaworld-<task>`` (idempotent, imports nothing heavy).
+
+    ``import sb3_gqn`` runs it, so ``gym.make("sb3_gqn/metaworld-reach-v3")`` and
+    ``GQN("MlpPolicy", "sb3_gqn/metaworld-reach-v3")`` work in plain Python; without the import, Gymnasium's
+    ``gym.make("sb3_gqn:sb3_gqn/metaworld-reach-v3")`` imports the package first. Making one needs ``metaworld``.
+    """
+    for task in METAWORLD_TASKS:
+        env_id = f"sb3_gqn/metaworld-{task}"
+        if env_id not in gym.registry:
+            gym.register(env_id, entry_point="sb3_gqn.envs:make_metaworld", kwargs={"env_name": task}, max_episode_steps=500)

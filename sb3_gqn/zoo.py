@@ -21,27 +21,19 @@ from typing import Any
 import gymnasium as gym
 
 from sb3_gqn.decqn import DecQN
+from sb3_gqn.envs import METAWORLD_TASKS, make_metaworld, register_project_envs  # noqa: F401  (re-exported)
 from sb3_gqn.gqn import GQN
 
 #: The project's hyperparameter files (rl-zoo3's format), shipped inside the package
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 #: The project's algorithms under their rl-zoo3 names
 ZOO_ALGOS: dict[str, type[GQN]] = {"gqn": GQN, "decqn": DecQN}
-#: Meta-World v3 tasks that get an rl-zoo3-nameable id ``sb3_gqn/metaworld-<task>``
-METAWORLD_TASKS = ("reach-v3", "push-v3", "pick-place-v3", "door-open-v3", "drawer-open-v3", "button-press-topdown-v3")
 
 
 def shipped_hyperparams(algo: str) -> Path | None:
     """The project's hyperparameter file for ``algo`` (``gqn``, ``decqn``, ``sac``, ``td3``), if it ships one."""
     path = HYPERPARAMS_DIR / f"{algo}.yml"
     return path if path.is_file() else None
-
-
-def make_metaworld(env_name: str = "reach-v3", **kwargs: Any) -> gym.Env:
-    """Meta-World v3's single-task benchmark env ``Meta-World/MT1`` for ``env_name`` (500-step episodes)."""
-    import metaworld  # noqa: F401  (registers the Meta-World/ ids)
-
-    return gym.make("Meta-World/MT1", env_name=env_name, **kwargs)
 
 
 def register_envs() -> None:
@@ -58,10 +50,7 @@ def register_envs() -> None:
         gym.register_envs(gymnasium_robotics)
     except ImportError:  # pragma: no cover - optional suite
         pass
-    for task in METAWORLD_TASKS:
-        env_id = f"sb3_gqn/metaworld-{task}"
-        if env_id not in gym.registry:
-            gym.register(env_id, entry_point="sb3_gqn.zoo:make_metaworld", kwargs={"env_name": task}, max_episode_steps=500)
+    register_project_envs()  # already done by importing sb3_gqn; idempotent
 
 
 def register() -> None:

@@ -1,0 +1,43 @@
+"""The project's env ids work wherever sb3_gqn is imported (and through Gymnasium's "module:id" syntax)."""
+
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip("metaworld")
+
+PLAIN_PYTHON = """
+import gymnasium as gym
+import sb3_gqn
+from sb3_gqn import GQN
+assert "sb3_gqn/metaworld-reach-v3" in gym.registry
+env = gym.make("sb3_gqn/metaworld-reach-v3")
+assert env.spec.max_episode_steps == 500 and env.action_space.shape == (4,)
+model = GQN("MlpPolicy", "sb3_gqn/metaworld-reach-v3", buffer_size=1000, seed=0)
+print("ok", model.observation_space.shape)
+"""
+
+
+def run_python(code: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=180)
+
+
+def test_env_ids_are_registered_on_import_in_plain_python():
+    result = run_python(PLAIN_PYTHON)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("ok (39,)")
+
+
+def test_gymnasium_module_prefix_imports_the_package():
+    code = 'import gymnasium as gym; env = gym.make("sb3_gqn:sb3_gqn/metaworld-reach-v3"); print(env.action_space.shape)'
+    result = run_python(code)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().endswith("(4,)")
+
+
+def test_importing_sb3_gqn_does_not_import_the_suites():
+    code = "import sys, sb3_gqn; print(sorted(m for m in ('metaworld', 'mujoco', 'shimmy', 'dm_control') if m in sys.modules))"
+    result = run_python(code)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
