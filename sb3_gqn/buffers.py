@@ -1,4 +1,5 @@
-"""Prioritized n-step replay (Schaul et al. 2016) on top of SB3's ``NStepReplayBuffer``."""
+"""Prioritized n-step replay (Schaul et al. 2016) on top of SB3's ``NStepReplayBuffer`` (array observations) and
+:class:`~sb3_gqn.nstep_dict.NStepDictReplayBuffer` (``Dict`` observations)."""
 
 from __future__ import annotations
 
@@ -9,9 +10,11 @@ import numpy as np
 import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
+from stable_baselines3.common.type_aliases import TensorDict
 from stable_baselines3.common.vec_env import VecNormalize
 
 from sb3_gqn.arguments import check_int, check_number
+from sb3_gqn.nstep_dict import NStepDictReplayBuffer
 from sb3_gqn.sum_tree import SumTree, check_priorities
 
 # The per-(row, env) arrays of SB3's ReplayBuffer; an env's column of each is a view of it.
@@ -21,9 +24,9 @@ _TRANSITION_ARRAYS = ("observations", "next_observations", "actions", "rewards",
 class PrioritizedReplayBufferSamples(NamedTuple):
     """SB3's ``ReplayBufferSamples`` fields plus the importance-sampling weights and the sampled indices."""
 
-    observations: th.Tensor
+    observations: th.Tensor | TensorDict
     actions: th.Tensor
-    next_observations: th.Tensor
+    next_observations: th.Tensor | TensorDict
     dones: th.Tensor
     rewards: th.Tensor
     discounts: th.Tensor | None
@@ -33,21 +36,21 @@ class PrioritizedReplayBufferSamples(NamedTuple):
     indices: np.ndarray
 
 
-class PrioritizedReplayBuffer(NStepReplayBuffer):
+class PrioritizedSampling:
     """
-    Proportional prioritized replay (Schaul et al. 2016) with n-step returns.
+    Proportional prioritized replay (Schaul et al. 2016) for an n-step buffer (mixed in before it).
 
-    Storage, ``add`` and the n-step return computation are SB3's ``NStepReplayBuffer``, unchanged
-    (``n_steps=1`` gives one-step returns). A :class:`~sb3_gqn.sum_tree.SumTree` holds one priority per
-    stored transition (``buffer_size`` rows times ``n_envs`` columns, 16 bytes each). ``sample`` draws
-    transition ``i`` with probability ``P(i) = p_i / sum_k p_k`` (stratified, Schaul et al. appendix
-    B.2.1) and returns, besides SB3's fields, the importance-sampling weights
-    ``w_i = (N * P(i)) ** -beta / max_j w_j`` (the maximum taken over the batch, as DecQN's Acme agents do)
-    and the indices for :meth:`update_priorities`. New transitions get the largest priority seen so far,
-    so each is sampled at least about as often as the most surprising old one.
+    Storage, ``add`` and the n-step return computation are the n-step buffer's, unchanged (``n_steps=1``
+    gives one-step returns). A :class:`~sb3_gqn.sum_tree.SumTree` holds one priority per stored transition
+    (``buffer_size`` rows times ``n_envs`` columns, 16 bytes each). ``sample`` draws transition ``i`` with
+    probability ``P(i) = p_i / sum_k p_k`` (stratified, Schaul et al. appendix B.2.1) and returns, besides
+    SB3's fields, the importance-sampling weights ``w_i = (N * P(i)) ** -beta / max_j w_j`` (the maximum taken
+    over the batch, as DecQN's Acme agents do) and the indices for :meth:`update_priorities`. New
+    transitions get the largest priority seen so far, so each is sampled at least about as often as the
+    most surprising old one.
 
     :param buffer_size: Max number of element in the buffer
-    :param observation_space: Observation space (``Dict`` is not supported: SB3 has no n-step Dict buffer)
+    :param observation_space: Observation space
     :param action_space: Action space
     :param device: PyTorch device
     :param n_envs: Number of parallel environments
@@ -64,6 +67,12 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
     :param epsilon: added to ``|td|`` so that no transition gets priority zero
     """
 
+    #: the n-step buffer class whose ``_get_samples`` computes the samples (set by the concrete classes)
+    n_step_buffer: type
+    buffer_size: int
+    n_envs: int
+    pos: int
+
     def __init__(
         self,
         buffer_size: int,
@@ -79,15 +88,10 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         beta: float = 0.2,
         epsilon: float = 1e-6,
     ):
-        if isinstance(observation_space, spaces.Dict):
-            raise ValueError(
-                "PrioritizedReplayBuffer does not support Dict observations (it builds on SB3's NStepReplayBuffer, "
-                "which has no Dict variant): flatten them (gymnasium.wrappers.FlattenObservation), or use "
-                "GQN(..., prioritized_replay=False, n_steps=1) for SB3's DictReplayBuffer."
-            )
+        self._check_observation_space(observation_space)
         if optimize_memory_usage:
             raise ValueError(
-                "PrioritizedReplayBuffer does not support optimize_memory_usage=True (neither does SB3's "
+                f"{type(self).__name__} does not support optimize_memory_usage=True (neither does SB3's "
                 "NStepReplayBuffer it builds on)"
             )
         check_int("buffer_size", buffer_size, 1)
@@ -97,7 +101,7 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
             raise ValueError(f"alpha (priority exponent) must be >= 0, got {alpha}")
         if not epsilon > 0:
             raise ValueError(f"epsilon must be > 0 so that no priority is zero, got {epsilon}")
-        super().__init__(
+        super().__init__(  # type: ignore[call-arg]
             buffer_size,
             observation_space,
             action_space,
@@ -114,6 +118,9 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         self.priorities = SumTree(self.buffer_size * self.n_envs)
         self.max_priority = 1.0
 
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        """Refuse an observation space the n-step buffer cannot store."""
+
     @property
     def beta(self) -> float:
         """Importance-sampling exponent used by the next ``sample``."""
@@ -127,8 +134,8 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
 
     def add(
         self,
-        obs: np.ndarray,
-        next_obs: np.ndarray,
+        obs: Any,
+        next_obs: Any,
         action: np.ndarray,
         reward: np.ndarray,
         done: np.ndarray,
@@ -136,7 +143,7 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
     ) -> None:
         """Store one transition per env (SB3's ``add``) with the maximum priority seen so far."""
         row = self.pos
-        super().add(obs, next_obs, action, reward, done, infos)
+        super().add(obs, next_obs, action, reward, done, infos)  # type: ignore[misc]
         first = row * self.n_envs
         self.priorities.update_unchecked(np.arange(first, first + self.n_envs), np.full(self.n_envs, self.max_priority))
 
@@ -155,25 +162,25 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         rows, env_columns = np.divmod(indices, self.n_envs)
 
         if self.n_envs == 1:
-            samples = super()._get_samples(rows, env=env)
+            samples = self.n_step_buffer._get_samples(self, rows, env=env)
         else:
             parts = [
-                NStepReplayBuffer._get_samples(self._env_column(int(column)), rows[env_columns == column], env=env)
+                self.n_step_buffer._get_samples(self._env_column(int(column)), rows[env_columns == column], env=env)
                 for column in np.unique(env_columns)
             ]
-            samples = type(parts[0])(*(th.cat(tensors) for tensors in zip(*parts)))
+            samples = type(parts[0])(*(_concatenate(fields) for fields in zip(*parts)))
 
         # P(i) = p_i / sum_k p_k over the N stored transitions; w_i = (N * P(i)) ** -beta / max_j w_j
         probabilities = self.priorities.nodes[indices + self.priorities.capacity] / self.priorities.total
-        weights = (self.size() * self.n_envs * probabilities) ** -self.beta
+        weights = (self.size() * self.n_envs * probabilities) ** -self.beta  # type: ignore[attr-defined]
         weights /= weights.max()
         return PrioritizedReplayBufferSamples(
             *samples,
-            weights=self.to_torch(weights.astype(np.float32).reshape(-1, 1)),
+            weights=self.to_torch(weights.astype(np.float32).reshape(-1, 1)),  # type: ignore[attr-defined]
             indices=indices,
         )
 
-    def _env_column(self, column: int) -> PrioritizedReplayBuffer:
+    def _env_column(self, column: int) -> PrioritizedSampling:
         """A shallow copy whose transition arrays are views of env ``column`` only (``n_envs=1``).
 
         SB3's ``_get_samples`` draws the env of each sample at random; running it on this one-env view
@@ -182,7 +189,11 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         view = copy.copy(self)
         view.n_envs = 1
         for name in _TRANSITION_ARRAYS:
-            setattr(view, name, getattr(self, name)[:, column : column + 1])
+            arrays = getattr(self, name)
+            if isinstance(arrays, dict):  # Dict observations: one array per key
+                setattr(view, name, {key: array[:, column : column + 1] for key, array in arrays.items()})
+            else:
+                setattr(view, name, arrays[:, column : column + 1])
         return view
 
     def update_priorities(self, indices: np.ndarray, td_errors: np.ndarray | th.Tensor) -> None:
@@ -202,7 +213,7 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         if td_errors.shape != indices.shape:
             raise ValueError(f"Got {indices.size} indices but {td_errors.size} TD errors")
         td_errors = check_priorities(td_errors, what="TD errors (absolute values |td|)")
-        stored = self.size() * self.n_envs
+        stored = self.size() * self.n_envs  # type: ignore[attr-defined]
         if not np.issubdtype(indices.dtype, np.integer):
             raise TypeError(f"Transition indices must be integers, got dtype {indices.dtype}")
         if indices.size and (indices.min() < 0 or indices.max() >= stored):
@@ -211,3 +222,34 @@ class PrioritizedReplayBuffer(NStepReplayBuffer):
         self.priorities.update_unchecked(indices, priorities)
         if priorities.size:
             self.max_priority = max(self.max_priority, float(priorities.max()))
+
+
+def _concatenate(fields: tuple[Any, ...]) -> Any:
+    """One field of several sample batches joined: tensors concatenated (per key for ``Dict`` observations)."""
+    if isinstance(fields[0], dict):
+        return {key: th.cat([field[key] for field in fields]) for key in fields[0]}
+    return None if fields[0] is None else th.cat(fields)
+
+
+class PrioritizedReplayBuffer(PrioritizedSampling, NStepReplayBuffer):
+    """Prioritized n-step replay for array observations on SB3's ``NStepReplayBuffer`` (see :class:`PrioritizedSampling`)."""
+
+    n_step_buffer = NStepReplayBuffer
+
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        if isinstance(observation_space, spaces.Dict):
+            raise ValueError(
+                "PrioritizedReplayBuffer stores array observations: use PrioritizedDictReplayBuffer for Dict "
+                "observations (GQN picks it by itself)"
+            )
+
+
+class PrioritizedDictReplayBuffer(PrioritizedSampling, NStepDictReplayBuffer):
+    """Prioritized n-step replay for ``Dict`` observations on :class:`~sb3_gqn.nstep_dict.NStepDictReplayBuffer`
+    (see :class:`PrioritizedSampling`)."""
+
+    n_step_buffer = NStepDictReplayBuffer
+
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        if not isinstance(observation_space, spaces.Dict):
+            raise ValueError(f"PrioritizedDictReplayBuffer needs a Dict observation space, got {observation_space}")

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ctypes.util
 import importlib
+import os
 from typing import Any
 
 import gymnasium as gym
@@ -22,10 +24,30 @@ SUITE_MODULES = {
 }
 
 
+def choose_headless_gl_backend() -> str | None:
+    """On a machine without a display, set ``MUJOCO_GL`` (if unset) to a backend that works there.
+
+    With ``MUJOCO_GL`` unset, dm_control tries GLFW first, which cannot work without ``DISPLAY`` and warns
+    ("X11: The DISPLAY environment variable is missing") on every import. Headless, its fallback order minus
+    GLFW is taken instead: EGL if ``libEGL`` is installed, else OSMesa, else ``disable`` (no rendering, as
+    dm_control ends up anyway). Returns the backend set, or ``None`` when nothing was changed.
+    """
+    if os.environ.get("MUJOCO_GL") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return None
+    backend = "disable"
+    if ctypes.util.find_library("EGL"):
+        backend = "egl"
+    elif ctypes.util.find_library("OSMesa"):
+        backend = "osmesa"
+    os.environ["MUJOCO_GL"] = backend
+    return backend
+
+
 def ensure_registered(env_id: str) -> None:
     """Import the package that registers ``env_id`` (shimmy for ``dm_control/...``, metaworld, ...)."""
     for prefix, module in SUITE_MODULES.items():
         if env_id.startswith(prefix):
+            choose_headless_gl_backend()
             try:
                 importlib.import_module(module)
             except ImportError as error:

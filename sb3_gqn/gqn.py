@@ -15,9 +15,10 @@ from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.policies import BasePolicy
 from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedule
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
+from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
 from sb3_gqn.arguments import check_int, check_learning_rate, check_number, check_replay_sizes, check_train_freq
-from sb3_gqn.buffers import PrioritizedReplayBuffer
+from sb3_gqn.buffers import PrioritizedDictReplayBuffer, PrioritizedReplayBuffer, PrioritizedSampling
 from sb3_gqn.envs import check_action_space, resolve_env
 from sb3_gqn.growth import (
     GROWTH_INITS,
@@ -29,6 +30,7 @@ from sb3_gqn.growth import (
     nested_bin_levels,
 )
 from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, active_bin_mask, epsilon_greedy
+from sb3_gqn.nstep_dict import NStepDictReplayBuffer
 from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
 from sb3_gqn.wrappers import BinGrid
@@ -77,10 +79,11 @@ class GQN(OffPolicyAlgorithm):
         32 samples per insert at batch 256.
     :param gradient_steps: How many gradient steps to do after each rollout (see ``train_freq``).
         Set to ``-1`` means to do as many gradient steps as steps done in the environment during the rollout.
-    :param replay_buffer_class: Replay buffer class to use. If ``None``:
-        :class:`~sb3_gqn.buffers.PrioritizedReplayBuffer` with ``prioritized_replay=True``, otherwise SB3's
-        choice (``NStepReplayBuffer`` for ``n_steps > 1``, ``DictReplayBuffer`` for Dict observations,
-        which requires ``n_steps=1`` and ``prioritized_replay=False``).
+    :param replay_buffer_class: Replay buffer class to use. If ``None``: with ``prioritized_replay=True``
+        :class:`~sb3_gqn.buffers.PrioritizedReplayBuffer` (:class:`~sb3_gqn.buffers.PrioritizedDictReplayBuffer`
+        for Dict observations), otherwise SB3's ``NStepReplayBuffer`` (:class:`~sb3_gqn.nstep_dict.NStepDictReplayBuffer`)
+        for ``n_steps > 1`` and ``ReplayBuffer`` (``DictReplayBuffer``) for ``n_steps=1``. SB3's ``HerReplayBuffer``
+        samples and relabels transitions itself: with it GQN uses one-step returns and no prioritization.
     :param replay_buffer_kwargs: Keyword arguments to pass to the replay buffer on creation.
     :param optimize_memory_usage: Enable a memory efficient variant of the replay buffer (``n_steps=1`` only)
     :param n_steps: number of steps of the n-step return (SB3's ``NStepReplayBuffer``)
@@ -323,28 +326,29 @@ class GQN(OffPolicyAlgorithm):
         self._apply_growth_level()
 
     def _setup_replay_buffer_class(self) -> None:
-        """Choose the prioritized n-step buffer by default; refuse combinations SB3 cannot serve."""
+        """Choose the prioritized n-step buffer by default (Dict observations included); adapt to HER."""
         dict_observations = isinstance(self.observation_space, spaces.Dict)
-        if self.replay_buffer_class is None and dict_observations and (self.n_steps > 1 or self.prioritized_replay):
-            raise ValueError(
-                f"Dict observations need n_steps=1 and prioritized_replay=False (got n_steps={self.n_steps}, "
-                f"prioritized_replay={self.prioritized_replay}): SB3 has no n-step Dict buffer for them to build on. "
-                "Pass both, or flatten the observations (gymnasium.wrappers.FlattenObservation)."
-            )
+        if self.replay_buffer_class is not None and issubclass(self.replay_buffer_class, HerReplayBuffer):
+            # HER relabels single transitions and samples them itself: one-step returns, uniform sampling
+            self.n_steps = 1
+            self.prioritized_replay = False
         if self.prioritized_replay:
             if self.replay_buffer_class is None:
-                self.replay_buffer_class = PrioritizedReplayBuffer
+                self.replay_buffer_class = PrioritizedDictReplayBuffer if dict_observations else PrioritizedReplayBuffer
                 self.replay_buffer_kwargs.update(
                     n_steps=self.n_steps,
                     gamma=self.gamma,
                     alpha=self.priority_exponent,
                     beta=self.importance_sampling_exponent,
                 )
-            elif not issubclass(self.replay_buffer_class, PrioritizedReplayBuffer):
+            elif not issubclass(self.replay_buffer_class, PrioritizedSampling):
                 raise ValueError(
                     f"replay_buffer_class={self.replay_buffer_class.__name__} is not prioritized: pass "
                     "prioritized_replay=False to train with it uniformly"
                 )
+        elif self.replay_buffer_class is None and dict_observations and self.n_steps > 1:
+            self.replay_buffer_class = NStepDictReplayBuffer  # SB3 has no n-step Dict buffer
+            self.replay_buffer_kwargs.update(n_steps=self.n_steps, gamma=self.gamma)
         self.importance_sampling_schedule = LinearSchedule(
             self.importance_sampling_exponent,
             1.0 if self.importance_sampling_annealing else self.importance_sampling_exponent,
@@ -479,7 +483,7 @@ class GQN(OffPolicyAlgorithm):
         # Update learning rate according to schedule
         self._update_learning_rate(self.policy.optimizer)
         active_bins_mask = self.policy.active_bins_mask
-        prioritized = isinstance(self.replay_buffer, PrioritizedReplayBuffer)
+        prioritized = isinstance(self.replay_buffer, PrioritizedSampling)
         if prioritized:
             self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)
 

@@ -23,6 +23,13 @@ RADAR_METRICS = {
     "action_change": "|Δa|",
     "smoothness": "SM",
 }
+RADAR_CAPTION = (
+    "R: task return (larger is better); P: action penalty c·Σa², |a|: mean action magnitude, |Δa|: mean action change "
+    "between steps, SM: smoothness (spectral, higher frequencies weigh more): smaller is smoother. "
+    "Each axis is the ratio to the reference agent."
+)
+RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+RADAR_DASHES = ("-", "--", "-.", ":")
 # Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
 PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
 PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
@@ -49,9 +56,11 @@ class QValueSnapshots(BaseCallback):
         with th.no_grad():
             utilities = self.model.q_net(th.as_tensor(observations, device=self.model.device))  # type: ignore[attr-defined]
         utilities = utilities[:, 0, :].cpu().numpy().reshape(len(PENDULUM_ANGLES), len(PENDULUM_VELOCITIES), -1)
+        grid = getattr(self.model, "action_grid", None)
         np.savez(
             self.run_dir / f"q_level{level}.npz",
             utilities=utilities,
+            bin_values=grid.values[0] if grid is not None else np.arange(utilities.shape[-1], dtype=np.float32),
             active_bins=self.model.bin_levels[level],  # type: ignore[attr-defined]
             max_bins=self.model.bin_levels[-1],  # type: ignore[attr-defined]
             angles=PENDULUM_ANGLES,
@@ -83,7 +92,15 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
     for (env, penalty), task in table.groupby(["env", "penalty"]):
         figure, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
         for index, warning in enumerate(warnings or []):
-            figure.text(0.5, 0.5 - 0.06 * index, warning, color="red", ha="center", fontsize=9, wrap=True)
+            figure.text(
+                0.5,
+                0.5 - 0.08 * index,
+                warning,
+                color="red",
+                ha="center",
+                fontsize=9,
+                bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
+            )
         for algo, runs in task.groupby("algo"):
             curve = runs.groupby("step").agg(
                 mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "mean")
@@ -152,6 +169,12 @@ def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray],
     return scores, tasks
 
 
+def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:
+    """Tasks (env, penalty) whose runs all ended at the same return: their min-max normalization has no range."""
+    task_range = final_rows(table).groupby(["env", "penalty"])["return"].agg(["min", "max"])
+    return [(str(env), float(c)) for (env, c), row in task_range.iterrows() if row["max"] == row["min"]]
+
+
 def iqm_with_intervals(scores: dict[str, np.ndarray], reps: int = 2000) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``)."""
     from rliable import library as rly
@@ -181,8 +204,15 @@ def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
     axis.set_yticks(range(len(algos)), algos)
     axis.set_xlabel("IQM of normalized final return (95 % bootstrap CI)")
     names = [f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks]
-    axis.set_title(f"{len(tasks)} task(s): " + textwrap.fill(", ".join(names), 90), fontsize=8)
-    figure.tight_layout()
+    axis.set_title(f"{len(tasks)} task{'s' if len(tasks) != 1 else ''}: " + textwrap.fill(", ".join(names), 90), fontsize=8)
+    degenerate = degenerate_tasks(table)
+    if degenerate:  # every run of the task ended at the same return: min-max normalization scores them all 0
+        listed = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in degenerate)
+        note = f"Normalization degenerate (all final returns equal, all scored 0) on: {listed}"
+        figure.text(0.5, 0.01, textwrap.fill(note, 90), color="red", ha="center", va="bottom", fontsize=7)
+        figure.tight_layout(rect=(0, 0.12, 1, 1))
+    else:
+        figure.tight_layout()
     path = out / "aggregate_iqm.png"
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -208,15 +238,25 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         means = runs.groupby(["algo", "penalty"])[list(RADAR_METRICS)].mean()
         base = means.loc[reference].replace(0.0, np.nan)
         angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
-        figure, axis = plt.subplots(figsize=(5.5, 5.5), subplot_kw={"projection": "polar"})
-        for (algo, penalty), values in means.iterrows():
+        figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
+        for index, ((algo, penalty), values) in enumerate(means.iterrows()):
             relative = (values / base).abs().fillna(0.0).to_numpy()
             closed = np.append(relative, relative[0])
-            axis.plot(np.append(angles, angles[0]), closed, label=f"{algo} c={penalty:g}")
+            # markers and dash patterns tell apart lines that coincide (e.g. two agents that are both bang-bang)
+            axis.plot(
+                np.append(angles, angles[0]),
+                closed,
+                label=f"{algo} c={penalty:g}",
+                marker=RADAR_MARKERS[index % len(RADAR_MARKERS)],
+                linestyle=RADAR_DASHES[index % len(RADAR_DASHES)],
+                markersize=6,
+                alpha=0.85,
+            )
         axis.set_xticks(angles, list(RADAR_METRICS.values()))
-        axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g}", fontsize=9)
-        axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
-        figure.tight_layout()
+        axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g} (= 1)", fontsize=9)
+        axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.2))
+        figure.text(0.5, 0.01, textwrap.fill(RADAR_CAPTION, 105), ha="center", va="bottom", fontsize=7)
+        figure.tight_layout(rect=(0, 0.07, 1, 1))
         path = out / f"smoothness_radar_{_slug(env)}.png"
         figure.savefig(path, dpi=110)
         plt.close(figure)
@@ -231,25 +271,41 @@ def q_value_picture(run_dir: Path, out: Path) -> Path | None:
         return None
     loaded: list[Any] = [np.load(path) for path in snapshots]
     max_bins = int(loaded[0]["max_bins"])
-    figure, axes = plt.subplots(len(loaded), max_bins, figsize=(1.3 * max_bins, 1.4 * len(loaded)), squeeze=False)
+    bin_values = loaded[0].get("bin_values")  # older snapshots lack them
+    figure, axes = plt.subplots(
+        len(loaded), max_bins, figsize=(1.35 * max_bins + 1.2, 1.5 * len(loaded) + 1.0), squeeze=False, layout="constrained"
+    )
     for row, snapshot in enumerate(loaded):
         utilities, active = snapshot["utilities"], int(snapshot["active_bins"])
         active_indices = set(np.linspace(0, max_bins - 1, active).round().astype(int).tolist())
         low, high = np.percentile(utilities, [2, 98])
-        extent = (snapshot["velocities"][0], snapshot["velocities"][-1], snapshot["angles"][0], snapshot["angles"][-1])
+        angles, velocities = snapshot["angles"], snapshot["velocities"]
+        extent = (velocities[0], velocities[-1], angles[0], angles[-1])
         for column in range(max_bins):
             axis = axes[row, column]
-            axis.imshow(utilities[:, :, column], origin="lower", aspect="auto", extent=extent, vmin=low, vmax=high)
-            axis.set_xticks([])
-            axis.set_yticks([])
+            image = axis.imshow(utilities[:, :, column], origin="lower", aspect="auto", extent=extent, vmin=low, vmax=high)
+            axis.set_xticks([velocities[0], 0, velocities[-1]] if row == len(loaded) - 1 else [])
+            axis.set_yticks([angles[0], 0, angles[-1]] if column == 0 else [])
+            axis.tick_params(labelsize=6)
+            if column == 0:
+                axis.set_yticklabels(["-π", "0", "π"])
             for spine in axis.spines.values():
                 spine.set_linewidth(2.5 if column in active_indices else 0.5)
                 spine.set_color("red" if column in active_indices else "grey")
             if row == 0:
-                axis.set_title(f"bin {column}", fontsize=8)
-        axes[row, 0].set_ylabel(f"{active} bins\nstep {int(snapshot['step'])}", fontsize=8)
-    figure.suptitle(f"{run_dir.name}: utilities over angle (vertical) x velocity; active bins outlined", fontsize=9)
-    figure.tight_layout()
+                value = f"\na = {bin_values[column]:+.2f}" if bin_values is not None else ""
+                axis.set_title(f"bin {column}{value}", fontsize=7)
+        axes[row, 0].set_ylabel(f"{active} bins, step {int(snapshot['step'])}\nangle [rad]", fontsize=7)
+        colorbar = figure.colorbar(image, ax=axes[row, :].tolist(), shrink=0.9, pad=0.01)
+        colorbar.ax.tick_params(labelsize=6)
+        colorbar.set_label("utility Q(s, bin)", fontsize=7)
+    for axis in axes[-1, :]:
+        axis.set_xlabel("velocity [rad/s]", fontsize=6)
+    figure.suptitle(
+        f"{run_dir.name}: per-bin utilities over angle x angular velocity at the end of each level "
+        "(a: the bin's torque; red frame: active bins; colour scale per row)",
+        fontsize=8,
+    )
     path = out / f"q_values_{run_dir.name}.png"
     figure.savefig(path, dpi=100)
     plt.close(figure)

@@ -21,7 +21,12 @@ from typing import Any
 import gymnasium as gym
 
 from sb3_gqn.decqn import DecQN
-from sb3_gqn.envs import METAWORLD_TASKS, make_metaworld, register_project_envs  # noqa: F401  (re-exported)
+from sb3_gqn.envs import (  # noqa: F401  (METAWORLD_TASKS, make_metaworld: re-exported)
+    METAWORLD_TASKS,
+    choose_headless_gl_backend,
+    make_metaworld,
+    register_project_envs,
+)
 from sb3_gqn.gqn import GQN
 
 #: The project's hyperparameter files (rl-zoo3's format), shipped inside the package
@@ -41,6 +46,7 @@ def register_envs() -> None:
 
     Suites that are not installed are skipped: their ids then stay unknown, which rl-zoo3 reports.
     """
+    choose_headless_gl_backend()  # before dm_control is imported: no GLFW attempt (and warning) without a display
     with contextlib.suppress(ImportError):  # shimmy registers the dm_control/ ids on import
         import shimmy  # noqa: F401
     try:
@@ -136,6 +142,23 @@ def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
     return [*kept, "-params", f"n_envs:{int(n_envs)}"]
 
 
+MISSING_ENTRY_HINT = """\
+This env has no entry in the hyperparameter file. Write one (rl-zoo3's YAML format) and pass the file with
+-conf my_hyperparams.yml, e.g. for a torque-controlled task:
+
+my-env-v0:
+  n_timesteps: !!float 2e5
+  policy: 'MlpPolicy'
+  bins: [2, 9]          # 9 -> 65 for velocity control
+  growth: 'adaptive'
+  train_freq: 2
+  env_wrapper:
+    - sb3_gqn.wrappers.ActionPenalty:
+        coef: 0.1
+
+How to choose bins, growth, the penalty and train_freq: README, "Train GQN on your own task"."""
+
+
 def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
     """Run an rl-zoo3 entry point on ``argv`` with the project's algorithms registered.
 
@@ -156,6 +179,8 @@ def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: st
             traceback.print_exc()
         message = str(error).strip().splitlines()[0] if str(error).strip() else ""
         print(f"{prog}: error: {type(error).__name__}: {message}", file=sys.stderr)
+        if message.startswith("Hyperparameters not found"):
+            print(MISSING_ENTRY_HINT, file=sys.stderr)
         return 1
     finally:
         sys.argv = saved_argv

@@ -1,5 +1,6 @@
 """The project's env ids work wherever sb3_gqn is imported (and through Gymnasium's "module:id" syntax)."""
 
+import os
 import subprocess
 import sys
 
@@ -41,3 +42,29 @@ def test_importing_sb3_gqn_does_not_import_the_suites():
     result = run_python(code)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[]"
+
+
+def test_no_display_warning_when_making_a_dm_control_env_headless():
+    environment = {key: value for key, value in os.environ.items() if key not in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY")}
+    code = "import os; from sb3_gqn.envs import make_env\nmake_env('dm_control/cartpole-swingup-v0')\n"
+    code += "print(os.environ['MUJOCO_GL'])"
+    result = subprocess.run(
+        [sys.executable, "-W", "default", "-c", code], capture_output=True, text=True, timeout=120, env=environment
+    )
+    assert result.returncode == 0, result.stderr
+    assert "DISPLAY" not in result.stderr and "GLFW" not in result.stderr
+    assert result.stdout.strip() in ("egl", "osmesa", "disable")
+
+
+def test_the_headless_backend_choice_respects_the_users_settings(monkeypatch):
+    from sb3_gqn.envs import choose_headless_gl_backend
+
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    assert choose_headless_gl_backend() is None
+    monkeypatch.delenv("MUJOCO_GL")
+    monkeypatch.setenv("DISPLAY", ":0")
+    assert choose_headless_gl_backend() is None  # a display: dm_control's own choice (GLFW) works
+    monkeypatch.delenv("DISPLAY")
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    backend = choose_headless_gl_backend()
+    assert backend in ("egl", "osmesa", "disable") and os.environ["MUJOCO_GL"] == backend

@@ -187,11 +187,21 @@ def test_dict_observations_with_multi_input_policy():
     assert action.shape == (2,) and set(action.tolist()) <= set(np.linspace(-1, 1, 9).tolist())
 
 
-def test_dict_observations_with_n_step_or_prioritized_replay_is_a_clear_error():
-    with pytest.raises(ValueError, match="n_steps=1 and prioritized_replay=False"):
-        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=3, prioritized_replay=False, **SMALL)
-    with pytest.raises(ValueError, match="n_steps=1 and prioritized_replay=False"):
-        GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, **SMALL)
+def test_dict_observations_get_n_step_and_prioritized_replay_by_default():
+    from stable_baselines3.common.buffers import DictReplayBuffer
+
+    from sb3_gqn.buffers import PrioritizedDictReplayBuffer
+    from sb3_gqn.nstep_dict import NStepDictReplayBuffer
+
+    model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), **SMALL)
+    assert type(model.replay_buffer) is PrioritizedDictReplayBuffer and model.replay_buffer.n_steps == 3
+    model.learn(300)
+    assert model._n_updates > 0 and model.replay_buffer.max_priority != 1.0  # priorities were updated
+    uniform = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), prioritized_replay=False, **SMALL)
+    assert type(uniform.replay_buffer) is NStepDictReplayBuffer and uniform.replay_buffer.n_steps == 3
+    uniform.learn(300)
+    one_step = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), prioritized_replay=False, n_steps=1, **SMALL)
+    assert type(one_step.replay_buffer) is DictReplayBuffer
 
 
 def test_discrete_env():

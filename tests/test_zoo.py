@@ -265,7 +265,16 @@ def test_every_shipped_entry_builds_its_env_and_model(algo, env_id, tmp_path):
         seed=0,
     )
     model, _ = manager.setup_experiment()
-    assert model.env is not None and model.get_env().observation_space.shape is not None
+    assert model.env is not None and model.get_env().observation_space is not None
     if algo in ("gqn", "decqn"):
         assert model.policy.action_dims == model.env.action_space.shape[0]
     model.env.close()
+
+
+def test_a_missing_entry_points_to_conf_and_the_readme(capsys, tmp_path):
+    from sb3_gqn.train import main
+
+    assert main(["--algo", "gqn", "--env", "CartPole-v1", "-f", str(tmp_path), "-n", "10"]) == 1
+    error = capsys.readouterr().err
+    assert "Hyperparameters not found for gqn-CartPole-v1" in error
+    assert "-conf my_hyperparams.yml" in error and '"Train GQN on your own task"' in error

@@ -1,0 +1,38 @@
+"""The figures' helpers: degenerate normalization, Q-value snapshots with the bins' action values."""
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from sb3_gqn import GQN
+from sb3_gqn.plots import aggregate, degenerate_tasks, normalized_final_scores, q_value_picture, save_q_snapshot
+
+
+def table(returns: dict[tuple[str, str], float]) -> pd.DataFrame:
+    rows = [
+        {"algo": algo, "env": env, "penalty": 0.1, "seed": 0, "step": step, "return": value if step == 200 else -1e4}
+        for (algo, env), value in returns.items()
+        for step in (100, 200)
+    ]
+    return pd.DataFrame(rows)
+
+
+def test_degenerate_normalization_is_detected_and_said_on_the_iqm_plot(tmp_path):
+    # task A: both algorithms end at -300 (no range: both scored 0); task B: -100 vs 50 (0 and 1)
+    results = table({("gqn", "A"): -300.0, ("sac", "A"): -300.0, ("gqn", "B"): -100.0, ("sac", "B"): 50.0})
+    assert degenerate_tasks(results) == [("A", 0.1)]
+    scores, tasks = normalized_final_scores(results)
+    assert tasks == [("A", 0.1), ("B", 0.1)]
+    np.testing.assert_array_equal(scores["gqn"], [[0.0, 0.0]])
+    np.testing.assert_array_equal(scores["sac"], [[0.0, 1.0]])
+    assert aggregate(results, tmp_path, reps=50).stat().st_size > 5_000
+
+
+def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
+    model = GQN("MlpPolicy", "Pendulum-v1", bins=(2, 9), growth="linear", learning_starts=50, buffer_size=500, seed=0)
+    model.learn(300, callback=save_q_snapshot(tmp_path))
+    snapshots = sorted(tmp_path.glob("q_level*.npz"))
+    assert len(snapshots) == 4  # the end of each of the 4 levels
+    np.testing.assert_allclose(np.load(snapshots[0])["bin_values"], np.linspace(-2.0, 2.0, 9))  # Pendulum's torque
+    assert q_value_picture(tmp_path, Path(tmp_path)).stat().st_size > 20_000
