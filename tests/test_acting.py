@@ -80,3 +80,16 @@ def test_plain_networks_skip_the_module_tree_walk():
     model.policy.set_training_mode(False)
     assert not model.policy.training and not model.q_net.training
     assert layer.training  # nothing below the online network's own flag is touched: no layer reads it
+
+
+@pytest.mark.parametrize("policy_kwargs", [dict(), dict(layer_norm=True, activation_fn=nn.ELU), dict(residual=True)])
+def test_the_layer_chain_computes_the_module_tree(policy_kwargs):
+    """The flat chain of layer forwards used for speed gives exactly what torso and head compute."""
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), policy_kwargs=dict(net_arch=[64, 64], **policy_kwargs), seed=0)
+    q_net = model.q_net
+    assert (q_net.layer_chain is None) == bool(policy_kwargs.get("residual"))  # residual blocks keep the tree
+    observations = th.randn(32, 3)
+    with th.no_grad():
+        model.q_net.head.bias.add_(0.5)  # parameters changed after construction are seen by the chain
+        expected = q_net.head(q_net.torso(observations)).view(-1, 3, 9)
+        np.testing.assert_array_equal(q_net(observations).numpy(), expected.numpy())
