@@ -4,6 +4,7 @@
     python -m sb3_gqn.benchmark --algos gqn-adaptive sac --envs dm_control/cartpole-swingup-v0 \\
         --penalties 0.1 --seeds 0 1 --steps 100000 --out results/cartpole
     python -m sb3_gqn.benchmark --full --list         # the paper-scale suite (list the runs only)
+    python -m sb3_gqn.benchmark --full --ray-address auto --threads 1 --out results/full   # on a Ray cluster
 
 Each run trains through the project's rl-zoo3 integration (ExperimentManager with the shipped
 hyperparameter file of its algorithm, the penalty set in the entry's ActionPenalty wrapper and the
@@ -26,6 +27,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
 from multiprocessing import get_context
@@ -181,10 +183,19 @@ class BenchmarkCallback(BaseCallback):
     ``wall_time`` counts training only (evaluations excluded).
     """
 
-    def __init__(self, spec: RunSpec, run_dir: Path, eval_env: gym.Env, eval_freq: int, n_episodes: int):
+    def __init__(
+        self,
+        spec: RunSpec,
+        run_dir: Path,
+        eval_env: gym.Env,
+        eval_freq: int,
+        n_episodes: int,
+        report_progress: Callable[[int], None] | None = None,
+    ):
         super().__init__()
         self.spec, self.run_dir, self.eval_env = spec, run_dir, eval_env
         self.eval_freq, self.n_episodes = eval_freq, n_episodes
+        self.report_progress = report_progress
         self.train_seconds, self.last_eval, self.started = 0.0, 0, 0.0
 
     def _on_training_start(self) -> None:
@@ -224,6 +235,8 @@ class BenchmarkCallback(BaseCallback):
             self.evaluate()
         if self.n_calls % 500 == 0:
             (self.run_dir / "progress").write_text(str(self.num_timesteps))
+            if self.report_progress is not None:
+                self.report_progress(self.num_timesteps)
         return True
 
     def _on_training_end(self) -> None:
@@ -231,8 +244,19 @@ class BenchmarkCallback(BaseCallback):
             self.evaluate()
 
 
-def run(spec: RunSpec, out: Path, eval_freq: int, eval_episodes: int, threads: int) -> str:
-    """Train and evaluate one run in this process; return its name. Skips a finished run."""
+def run(
+    spec: RunSpec,
+    out: Path,
+    eval_freq: int,
+    eval_episodes: int,
+    threads: int,
+    report_progress: Callable[[int], None] | None = None,
+) -> str:
+    """Train and evaluate one run in this process; return its name. Skips a finished run.
+
+    ``report_progress`` (optional) is called with the run's env steps every 500 steps (the Ray runner
+    forwards them to the driver; locally the driver reads ``runs/<run>/progress``).
+    """
     run_dir = out / "runs" / spec.name
     if (run_dir / "done.json").is_file():
         return spec.name
@@ -268,7 +292,7 @@ def run(spec: RunSpec, out: Path, eval_freq: int, eval_episodes: int, threads: i
     wrapper = get_wrapper_class({"env_wrapper": wrappers})
     eval_env = gym.make(spec.env)
     eval_env = wrapper(eval_env) if wrapper is not None else eval_env
-    manager.callbacks.append(BenchmarkCallback(spec, run_dir, eval_env, eval_freq, eval_episodes))
+    manager.callbacks.append(BenchmarkCallback(spec, run_dir, eval_env, eval_freq, eval_episodes, report_progress))
     if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
         manager.callbacks.append(save_q_snapshot(run_dir))
     started = time.perf_counter()
@@ -352,6 +376,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "--threads", type=int, help="torch threads per run (default: cores / jobs; lower it when other work shares the cores)"
     )
     parser.add_argument("--out", default="results/benchmark", help="output folder")
+    parser.add_argument(
+        "--ray-address",
+        help="run every run as a task on this Ray cluster ('auto': the cluster this process runs in; needs the ray extra); "
+        "the driver alone writes --out",
+    )
+    parser.add_argument("--ray-gpus", type=float, default=0.0, help="GPU fraction each Ray task reserves (default 0)")
+    parser.add_argument("--ray-retries", type=int, default=3, help="retries of a run whose worker or node dies (default 3)")
     parser.add_argument("--list", action="store_true", help="list the runs and their state, train nothing")
     parser.add_argument("--no-plots", action="store_true")
     args = parser.parse_args(argv)
@@ -369,12 +400,18 @@ def _report(
     out: Path,
     running: dict[str, RunSpec],
     recorded: RecordedRuns,
+    steps_by_run: dict[str, int] | None = None,
 ) -> str:
+    """One progress line: runs done / total, then each running run's steps (from ``steps_by_run`` when given,
+    else from the run folder's ``progress`` file)."""
     done = sum(is_finished(spec, out, recorded) for spec in specs)
     parts = [f"[{done}/{len(specs)} runs done]"]
     for name, spec in running.items():
-        progress = out / "runs" / name / "progress"
-        steps = progress.read_text() if progress.is_file() else "0"
+        if steps_by_run is not None:
+            steps = str(steps_by_run.get(name, 0))
+        else:
+            progress = out / "runs" / name / "progress"
+            steps = progress.read_text() if progress.is_file() else "0"
         parts.append(f"{name}: {steps}/{spec.steps} steps")
     return "  ".join(parts)
 
@@ -405,7 +442,23 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     jobs = max(1, min(args.jobs, len(pending) or 1))
     threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)
-    if pending:
+    if pending and args.ray_address:
+        from sb3_gqn.ray_suite import run_on_ray
+
+        out.mkdir(parents=True, exist_ok=True)
+        run_on_ray(
+            pending,
+            specs,
+            out,
+            recorded,
+            address=args.ray_address,
+            eval_freq=args.eval_freq,
+            eval_episodes=args.eval_episodes,
+            threads=args.threads or 1,
+            gpus=args.ray_gpus,
+            retries=args.ray_retries,
+        )
+    elif pending:
         out.mkdir(parents=True, exist_ok=True)
         with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
             futures: dict[Future, RunSpec] = {

@@ -149,3 +149,17 @@ def test_help_texts_are_plain_text(module, capsys):
         entry_point(["--help"])
     text = capsys.readouterr().out
     assert "usage:" in text and "``" not in text and not re.search(r":(func|mod|class|meth):", text)
+
+
+def test_the_local_runner_imports_no_ray():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from sb3_gqn.benchmark import main\n"
+        "main(['--algos', 'gqn-linear', '--envs', 'Pendulum-v1', '--list'])\n"
+        "print('ray' in sys.modules)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip().splitlines()[-1] == "False"

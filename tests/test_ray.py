@@ -1,0 +1,145 @@
+"""The comparison runner on a real Ray cluster on this machine: a head and a worker node started with `ray start`
+as separate processes on 127.0.0.1, against the same suite run locally; a worker node killed mid-run."""
+
+import csv
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+ray = pytest.importorskip("ray")
+
+from sb3_gqn.benchmark import main  # noqa: E402
+from sb3_gqn.ray_suite import progress_board_name  # noqa: E402
+
+pytestmark = pytest.mark.slow  # two clusters and a few short trainings: ~2 minutes on 2 cores
+
+RAY = shutil.which("ray", path=os.path.dirname(sys.executable)) or "ray"
+SUITE = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--eval-episodes", "1", "--threads", "1", "--no-plots"]
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def ray_command(*arguments: str, **kwargs) -> subprocess.CompletedProcess:
+    environment = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", "OMP_NUM_THREADS": "1"}
+    return subprocess.run([RAY, *arguments], capture_output=True, text=True, timeout=120, env=environment, **kwargs)
+
+
+class Cluster:
+    """A head node and one worker node, each `ray start` on 127.0.0.1 with one CPU; everything stopped at the end."""
+
+    def __init__(self, temp_dir: Path):
+        self.port = free_port()
+        self.address = f"127.0.0.1:{self.port}"
+        self.temp_dir = temp_dir
+        head = ray_command(
+            "start", "--head", "--node-ip-address=127.0.0.1", f"--port={self.port}", "--num-cpus=1",
+            "--include-dashboard=false", "--disable-usage-stats",
+        )  # fmt: skip
+        assert head.returncode == 0, head.stderr
+        environment = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", "OMP_NUM_THREADS": "1"}
+        self.worker = subprocess.Popen(
+            [RAY, "start", f"--address={self.address}", "--node-ip-address=127.0.0.1", "--num-cpus=1", "--block"],
+            stdout=open(temp_dir / "worker.log", "w"),  # noqa: SIM115
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # its own process group: killing it takes the whole node down
+            env=environment,
+        )
+        self.wait_for_cpus(2.0)
+
+    def wait_for_cpus(self, cpus: float, timeout: float = 90.0) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            status = ray_command("status", f"--address={self.address}")
+            if f"/{cpus:.1f} CPU" in status.stdout:
+                return
+            time.sleep(1.0)
+        raise TimeoutError(f"the cluster at {self.address} did not reach {cpus} CPUs:\n{status.stdout}{status.stderr}")
+
+    def kill_worker_node(self) -> None:
+        if self.worker.poll() is None:
+            os.killpg(self.worker.pid, signal.SIGKILL)
+            self.worker.wait(timeout=30)
+
+    def stop(self) -> None:
+        if ray.is_initialized():
+            ray.shutdown()
+        self.kill_worker_node()
+        ray_command("stop", "--force")
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    started = Cluster(tmp_path)
+    try:
+        yield started
+    finally:
+        started.stop()
+
+
+def table(out: Path) -> list[dict[str, str]]:
+    with open(out / "results.csv", newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_ray_suite_writes_the_same_rows_and_returns_as_a_local_run(cluster, tmp_path):
+    # 1200 steps: 200 gradient steps after learning_starts=1000, so the returns depend on the training
+    suite = ["--algos", "gqn-linear", "decqn-2", *SUITE, "--steps", "1200", "--eval-freq", "600"]
+    assert main([*suite, "--jobs", "2", "--out", str(tmp_path / "local")]) == 0
+    assert main([*suite, "--ray-address", cluster.address, "--out", str(tmp_path / "ray")]) == 0
+    local, remote = table(tmp_path / "local"), table(tmp_path / "ray")
+    key = ("algo", "env", "penalty", "seed", "step")
+    assert [tuple(row[k] for k in key) for row in remote] == [tuple(row[k] for k in key) for row in local]
+    assert len(remote) == 4
+    for local_row, remote_row in zip(local, remote, strict=True):
+        assert remote_row["return"] == local_row["return"] and remote_row["growth_events"] == local_row["growth_events"]
+    for name in ("gqn-linear__Pendulum-v1__c0.1__seed0", "decqn-2__Pendulum-v1__c0.1__seed0"):
+        assert (tmp_path / "ray" / "runs" / name / "done.json").is_file()  # the driver wrote the returned files
+    # A second invocation submits nothing: every run is recorded
+    assert main([*suite, "--ray-address", cluster.address, "--out", str(tmp_path / "ray"), "--list"]) == 0
+
+
+def test_a_killed_worker_node_costs_a_retry_not_a_run(cluster, tmp_path):
+    out = tmp_path / "suite"
+    algos = ["gqn-linear", "decqn-2", "decqn-9"]
+    suite = ["--algos", *algos, *SUITE, "--steps", "3000", "--eval-freq", "1000", "--out", str(out)]
+    ray.init(address=cluster.address, logging_level="WARNING", log_to_driver=False)
+    head = next(node["NodeID"] for node in ray.nodes() if "node:__internal_head__" in node["Resources"])
+    results: list[int] = []
+    driver = threading.Thread(target=lambda: results.append(main([*suite, "--ray-address", cluster.address])))
+    driver.start()
+    # Wait until a run is in flight on the worker node, then kill that node (raylet, workers, everything)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        try:
+            attempts = ray.get(ray.get_actor(progress_board_name(out)).nodes.remote())
+        except ValueError:  # the driver has not created the board yet
+            attempts = {}
+        if any(head not in nodes for nodes in attempts.values()):
+            break
+        time.sleep(0.5)
+    else:
+        pytest.fail("no run started on the worker node")
+    time.sleep(2.0)  # let it train for a moment
+    cluster.kill_worker_node()
+    driver.join(timeout=300)
+    assert not driver.is_alive() and results == [0]
+
+    rows = table(out)
+    runs = [(row["algo"], int(row["step"])) for row in rows]
+    assert sorted(runs) == sorted((algo, step) for algo in algos for step in (1000, 2000, 3000))  # each exactly once
+    attempts = json.loads((out / "ray_attempts.json").read_text())
+    retried = [name for name, nodes in attempts.items() if len(nodes) > 1]
+    assert len(retried) == 1 and attempts[retried[0]][-1] == head  # retried on the surviving node
