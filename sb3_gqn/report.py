@@ -58,13 +58,17 @@ class GrowthCheck:
 
 
 def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
-    """Every growth event of every run in ``table`` with the last evaluation before and the first after it."""
+    """Every growth event of every run in ``table`` with the last evaluation before and the first after it.
+
+    An evaluation at the very step of a growth comes after it (the growth callback runs before every other
+    callback of that step, so that evaluation already acts with the new bins: its ``active_bins`` say so).
+    """
     checks = []
     for (algo, env, _, seed), run in table.groupby(["algo", "env", "penalty", "seed"]):
         run = run.sort_values("step")
         steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
         for step, bins in run_growth_events(run):
-            earlier, later = np.flatnonzero(steps <= step), np.flatnonzero(steps > step)
+            earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
             checks.append(
                 GrowthCheck(
                     str(algo),

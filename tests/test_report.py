@@ -51,6 +51,16 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
         (19000, 5, 10_000, 400.0, 20_000, 500.0, True),
         (25000, 9, 20_000, 500.0, 30_000, 200.0, False),  # 200 < 0.7 * 500
     ]
+    # Linear growth at an evaluation step: that evaluation already ran with the new bins, so it is "after"
+    linear = pd.DataFrame([_row("gqn-linear", 0, 10_000, 300.0), _row("gqn-linear", 0, 20_000, 100.0, "20000:3")])
+    [check] = growth_checks(linear)
+    assert (check.before_step, check.before, check.after_step, check.after, check.held) == (
+        10_000,
+        300.0,
+        20_000,
+        100.0,
+        False,
+    )
     text = report(table, reps=50)
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 30000 | 200 |" in text
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 25000 -> 9 | 500 (20000) | 200 (30000) | **no** |" in text
