@@ -68,6 +68,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-9+layernorm": ("decqn", {"bins": 9, "policy_kwargs": REFERENCE_TORSO}),
     # ... with 1 gradient step per env step (SAC's ratio) instead of 1 per 2
     "gqn-adaptive+layernorm+1update": ("gqn", {"growth": "adaptive", "policy_kwargs": REFERENCE_TORSO, "train_freq": 1}),
+    "decqn-9+layernorm+1update": ("decqn", {"bins": 9, "policy_kwargs": REFERENCE_TORSO, "train_freq": 1}),
 }
 ABLATION = ["gqn-before", "gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared", "gqn-adaptive"]
 SHORT_SUITE = dict(
