@@ -377,16 +377,14 @@ class GQNPolicy(BasePolicy):
                 obs_tensor = obs_tensor.to(mask.device)
         else:
             obs_tensor = th.as_tensor(observation, device=mask.device)
-        return self._greedy_bins(q_net, obs_tensor, mask)
+        return self._greedy_bins(obs_tensor)
 
-    def _greedy_bins(self, q_net: DecoupledQNetwork, obs_tensor: PyTorchObs, mask: th.Tensor) -> np.ndarray:
-        """Paper eq. 3's greedy bins as a NumPy array ``(batch, *action_space.shape)``, in evaluation mode."""
+    def _greedy_bins(self, obs_tensor: PyTorchObs) -> np.ndarray:
+        """:meth:`_predict`'s greedy bins as a NumPy array ``(batch, *action_space.shape)``, in evaluation mode."""
         if self._mode_dependent:
             self.set_training_mode(False)
         with th.inference_mode():
-            bins = masked_argmax(q_net.forward(obs_tensor), mask)
-        if self._discrete_actions:
-            bins = bins.squeeze(-1)
+            bins = self._predict(obs_tensor)
         return bins.numpy() if bins.is_cpu else bins.cpu().numpy()
 
     def predict(
@@ -414,7 +412,7 @@ class GQNPolicy(BasePolicy):
                 "(Gym API) vs `obs = vec_env.reset()` (SB3 VecEnv API)"
             )
         obs_tensor, vectorized_env = self.obs_to_tensor(observation)
-        actions = self._greedy_bins(self.q_net, obs_tensor, self.active_bins_mask)
+        actions = self._greedy_bins(obs_tensor)
         if not vectorized_env:
             actions = actions.squeeze(axis=0)
         return actions, state
