@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv results test test-slow lint benchmark constraints clean
+.PHONY: venv results test test-slow lint benchmark readme-tables constraints clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,10 @@ test-slow: venv
 benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
+
+# The README's generated results blocks and docs/results/main's figures, from the committed docs/results tables
+readme-tables: venv
+	$(BIN)/python docs/results/readme_tables.py
 
 # Re-pin the whole dependency set from a fresh environment
 constraints:

@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from sb3_gqn.arguments import check_int, check_number
+
 if TYPE_CHECKING:
     from sb3_gqn.gqn import GQN
 
@@ -178,18 +180,15 @@ class AdaptiveGrowth:
     episode_returns: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
+        # The constructor's own checks (sb3_gqn.arguments), under the names GQN's arguments carry
         if self.returns_source not in RETURN_SOURCES:
             raise ValueError(f"growth_returns must be one of {RETURN_SOURCES}, got {self.returns_source!r}")
-        for name in ("eval_freq", "eval_episodes", "window"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
-                raise ValueError(f"growth {name} must be a positive integer, got {value!r}")
-        if self.patience is not None and (
-            not isinstance(self.patience, (int, np.integer)) or isinstance(self.patience, bool) or self.patience < 1
-        ):
-            raise ValueError(f"growth_patience must be a positive integer or None, got {self.patience!r}")
-        if not np.isfinite(self.min_improvement) or self.min_improvement < 0:
-            raise ValueError(f"growth_min_improvement must be a finite number >= 0, got {self.min_improvement!r}")
+        self.eval_freq = check_int("growth_eval_freq", self.eval_freq, 1)
+        self.eval_episodes = check_int("growth_eval_episodes", self.eval_episodes, 1)
+        self.window = check_int("growth_window", self.window, 1)
+        if self.patience is not None:
+            self.patience = check_int("growth_patience", self.patience, 1)
+        self.min_improvement = check_number("growth_min_improvement", self.min_improvement, 0.0)
         if self.next_eval_step == 0:
             self.next_eval_step = self.eval_freq
 

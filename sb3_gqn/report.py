@@ -3,6 +3,7 @@
     python -m sb3_gqn.report docs/results/*/results.csv               # tables for the README
     python -m sb3_gqn.report docs/results/*/results.csv --plots docs/results/all   # plus the cross-task IQM plot
     python -m sb3_gqn.report docs/results/*/results.csv --algos gqn-adaptive decqn-9 decqn-2   # only these
+    python -m sb3_gqn.report ... --shipped dm_control/walker-walk-v0=+layernorm+1update   # walker's entries
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
@@ -107,6 +108,23 @@ def load(paths: list[Path]) -> pd.DataFrame:
     return table.drop_duplicates(subset=["algo", "env", "penalty", "seed", "step"], keep="last")
 
 
+def as_shipped(table: pd.DataFrame, env: str, suffix: str) -> pd.DataFrame:
+    """The table with ``env``'s runs of the shipped configuration under the plain names.
+
+    When a task's shipped entries are what a runner variant overrides (e.g. walker-walk's entries are the
+    ``+layernorm+1update`` variants'), that variant's runs are the defaults' runs on it: on ``env``, each
+    ``algo + suffix`` becomes ``algo``, and the ``algo`` runs of the earlier entry are left out. Other tasks,
+    and algorithms without such a variant on ``env`` (SAC), are unchanged.
+    """
+    on_env = table["env"] == env
+    variants = {name for name in table.loc[on_env, "algo"].unique() if name.endswith(suffix) and name != suffix}
+    replaced = {name[: -len(suffix)] for name in variants}
+    kept = table[~(on_env & table["algo"].isin(replaced))].copy()
+    renamed = on_env[kept.index] & kept["algo"].isin(variants)
+    kept.loc[renamed, "algo"] = kept.loc[renamed, "algo"].str[: -len(suffix)]
+    return kept
+
+
 def report(table: pd.DataFrame, reps: int = 2000) -> str:
     """All tables as one markdown text."""
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
@@ -178,12 +196,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--plots", type=Path, help="also draw the suite's figures for the combined table into this folder")
     parser.add_argument("--reps", type=int, default=2000, help="bootstrap repetitions of the IQM intervals")
     parser.add_argument("--algos", nargs="+", help="only these algorithms (also for the IQM's per-task normalization)")
+    parser.add_argument(
+        "--shipped",
+        nargs="+",
+        default=[],
+        metavar="ENV=SUFFIX",
+        help="on ENV the shipped entries are the runner's SUFFIX variants: report their runs under the plain "
+        "names, in place of the runs of the earlier entry (e.g. dm_control/walker-walk-v0=+layernorm+1update)",
+    )
     args = parser.parse_args(argv)
+    shipped = [item.split("=", 1) for item in args.shipped]
+    if any(len(item) != 2 or not all(item) for item in shipped):
+        parser.error(f"--shipped takes ENV=SUFFIX pairs, got {args.shipped}")
     missing = [str(path) for path in args.tables if not path.is_file()]
     if missing:
         print(f"sb3_gqn.report: error: no such table: {', '.join(missing)}", file=sys.stderr)
         return 2
     table = load(args.tables)
+    for env, suffix in shipped:
+        table = as_shipped(table, env, suffix)
     if args.algos:
         table = table[table["algo"].isin(args.algos)]
     print(report(table, args.reps))

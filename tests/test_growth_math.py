@@ -61,10 +61,15 @@ def test_adaptive_evaluation_episodes_are_scheduled_and_averaged():
 
 
 def test_adaptive_rejects_bad_arguments():
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="growth_returns"):
         AdaptiveGrowth(returns_source="bogus")
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="growth_window must be an integer >= 1, got 0"):
         AdaptiveGrowth(window=0)
+    with pytest.raises(ValueError, match="growth_patience must be an integer >= 1, got True"):
+        AdaptiveGrowth(patience=True)
+    with pytest.raises(ValueError, match=r"growth_min_improvement must be a finite number in \[0, inf\), got nan"):
+        AdaptiveGrowth(min_improvement=float("nan"))
+    assert AdaptiveGrowth(patience=None).patience is None
 
 
 def test_adaptive_restarts_evaluation_clock_when_step_counter_resets():

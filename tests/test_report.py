@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from sb3_gqn.report import growth_checks, held_after_growth, report
+from sb3_gqn.report import as_shipped, growth_checks, held_after_growth, main, report
 
 
 def test_held_after_growth_hand_values():
@@ -15,10 +15,10 @@ def test_held_after_growth_hand_values():
     assert held_after_growth(-500.0, -550.0) and not held_after_growth(-500.0, -551.0)
 
 
-def _row(algo, seed, step, value, events=""):
+def _row(algo, seed, step, value, events="", env="dm_control/cartpole-swingup-v0"):
     return dict(
         algo=algo,
-        env="dm_control/cartpole-swingup-v0",
+        env=env,
         penalty=0.1,
         seed=seed,
         step=step,
@@ -64,3 +64,33 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
     text = report(table, reps=50)
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 30000 | 200 |" in text
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 25000 -> 9 | 500 (20000) | 200 (30000) | **no** |" in text
+
+
+def test_as_shipped_puts_the_variant_runs_under_the_plain_names_on_that_task_only(tmp_path, capsys):
+    walker = "dm_control/walker-walk-v0"
+    table = pd.DataFrame(
+        [
+            _row("gqn-adaptive", 0, 100_000, 800.0),  # cartpole: no variant there, kept
+            _row("gqn-adaptive", 0, 100_000, 100.0, env=walker),  # the earlier walker entry: left out
+            _row("gqn-adaptive+layernorm+1update", 0, 100_000, 500.0, env=walker),
+            _row("decqn-9", 0, 100_000, 300.0, env=walker),  # no decqn-9 variant on walker: kept
+            _row("gqn-adaptive+layernorm", 0, 100_000, 150.0, env=walker),  # another suffix: untouched
+            _row("sac", 0, 100_000, 530.0, env=walker),
+        ]
+    )
+    shipped = as_shipped(table, walker, "+layernorm+1update")
+    assert sorted(zip(shipped["env"], shipped["algo"], shipped["return"])) == [
+        ("dm_control/cartpole-swingup-v0", "gqn-adaptive", 800.0),
+        (walker, "decqn-9", 300.0),
+        (walker, "gqn-adaptive", 500.0),
+        (walker, "gqn-adaptive+layernorm", 150.0),
+        (walker, "sac", 530.0),
+    ]
+    path = tmp_path / "results.csv"
+    table.to_csv(path, index=False)
+    assert main([str(path), "--shipped", f"{walker}=+layernorm+1update", "--algos", "gqn-adaptive", "--reps", "10"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "| walker-walk-v0 | gqn-adaptive | 0 | 100000 | 500 |" in out
+        and "| walker-walk-v0 | gqn-adaptive | 0 | 100000 | 100 |" not in out
+    )

@@ -1,0 +1,112 @@
+"""Rebuild the README's generated results blocks from the committed tables (``make readme-tables``).
+
+Each block sits between ``<!-- BEGIN generated: NAME -->`` and ``<!-- END generated: NAME -->`` in README.md and
+is the output of ``sb3_gqn.report`` on the committed ``docs/results/*/results.csv`` files; the prose around
+the blocks (what the figures mean, what misses) is written by hand. Figures go to ``docs/results/main``.
+Run from the repository root after extending a table with the comparison runner.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from sb3_gqn.plots import plot_suite
+from sb3_gqn.report import as_shipped, load, report
+
+RESULTS = Path("docs/results")
+README = Path("README.md")
+#: walker-walk's shipped entries (gqn.yml, decqn.yml) are the runner's ``+layernorm+1update`` variants
+SHIPPED = {"dm_control/walker-walk-v0": "+layernorm+1update"}
+MAIN_ALGOS = ["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"]
+PROBES = [
+    "gqn-before",
+    "gqn-before+warm-start",
+    "gqn-before+plateau",
+    "gqn-before+shared",
+    "gqn-adaptive+layernorm",
+    "decqn-9+layernorm",
+]
+MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
+
+
+def sections(text: str) -> dict[str, str]:
+    """``report``'s markdown split at its ``### `` headings: ``{heading: body}``."""
+    found = {}
+    for part in re.split(r"^### ", text, flags=re.M)[1:]:
+        heading, body = part.split("\n", 1)
+        found[heading.strip()] = body.strip()
+    return found
+
+
+def pick(found: dict[str, str], prefix: str) -> tuple[str, str]:
+    """The (heading, body) whose heading starts with ``prefix``."""
+    return next((heading, body) for heading, body in found.items() if heading.startswith(prefix))
+
+
+def main_comparison() -> str:
+    table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])
+    for env, suffix in SHIPPED.items():
+        table = as_shipped(table, env, suffix)
+    table = table[table["algo"].isin(MAIN_ALGOS)]
+    found = sections(report(table, reps=2000))
+    plot_table = RESULTS / "main" / "shipped.csv"
+    table.to_csv(plot_table, index=False)
+    try:
+        plot_suite(plot_table, RESULTS / "main")
+    finally:
+        plot_table.unlink()
+    iqm_heading, iqm = pick(found, "IQM")
+    growth_heading, growth = pick(found, "Returns around each growth")
+    return "\n\n".join(
+        [
+            "**Final greedy evaluation, gqn-adaptive vs gqn-linear vs decqn-9 vs decqn-2 (shipped entries)**",
+            pick(found, "Final greedy evaluation")[1],
+            "**Mean over seeds**",
+            pick(found, "Mean over seeds")[1],
+            f"**{growth_heading}** (an evaluation at the step of a growth is already after it)",
+            growth,
+            f"**{iqm_heading}**",
+            iqm,
+            "\n".join(
+                f"![{path.stem.replace('_', ' ')}](docs/results/main/{path.name})"
+                for path in sorted((RESULTS / "main").glob("learning_curves_*.png"))
+            ),
+        ]
+    )
+
+
+def probes() -> str:
+    """The ablation and probe runs, and on the tasks of ``SHIPPED`` the runs of the entries shipped before."""
+    table = load(sorted(RESULTS.glob("*/results.csv")))
+    earlier = table["env"].isin(list(SHIPPED)) & table["algo"].isin(MAIN_ALGOS)
+    table.loc[earlier, "algo"] = table.loc[earlier, "algo"] + " (earlier entry)"
+    table = table[table["algo"].isin(PROBES) | table["algo"].str.endswith(("+layernorm+1update", "(earlier entry)"))]
+    return pick(sections(report(table, reps=100)), "Final greedy evaluation")[1]
+
+
+BLOCKS: dict[str, Callable[[], str]] = {"issue-11-main": main_comparison, "issue-11-probes": probes}
+
+
+def replace_block(text: str, name: str, body: str) -> str:
+    begin, end = f"<!-- BEGIN generated: {name} -->", f"<!-- END generated: {name} -->"
+    if begin not in text or end not in text:
+        raise SystemExit(f"{README}: no block {begin} ... {end}")
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    return f"{head}{begin}\n{body}\n{end}{tail}"
+
+
+def run() -> int:
+    text = README.read_text()
+    for name, build in BLOCKS.items():
+        text = replace_block(text, name, build())
+    README.write_text(text)
+    print(f"{README}: rebuilt {', '.join(BLOCKS)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run())
