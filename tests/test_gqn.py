@@ -351,3 +351,22 @@ def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
     assert eq4_only.active_bins == 2
     with_plateau = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=2, **SMALL).learn(400)
     assert with_plateau.active_bins == 9
+
+
+@pytest.mark.parametrize(
+    "torso", [dict(layer_norm=True, activation_fn=th.nn.ELU), dict(residual=True), dict(layer_norm=True, residual=True)]
+)
+def test_every_torso_option_learns_grows_and_round_trips(torso, tmp_path):
+    """The documented torso options (walker's shipped entry uses the first) train through growth and load back."""
+    options = {**SMALL, "policy_kwargs": dict(net_arch=[32, 32], **torso)}
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, **options)
+    model.learn(400)
+    assert model.active_bins == 9 and model._n_updates > 0
+    layers = [type(layer) for layer in model.q_net.modules()]
+    assert (th.nn.LayerNorm in layers) == bool(torso.get("layer_norm"))
+    observations = np.random.default_rng(0).normal(size=(64, 3)).astype(np.float32)
+    expected, _ = model.predict(observations, deterministic=True)
+    model.save(tmp_path / "gqn")
+    loaded = GQN.load(tmp_path / "gqn", env=DecliningEnv())
+    np.testing.assert_array_equal(loaded.predict(observations, deterministic=True)[0], expected)
+    loaded.learn(100, reset_num_timesteps=False)
