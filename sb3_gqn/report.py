@@ -125,10 +125,19 @@ def as_shipped(table: pd.DataFrame, env: str, suffix: str) -> pd.DataFrame:
     return kept
 
 
-def report(table: pd.DataFrame, reps: int = 2000) -> str:
-    """All tables as one markdown text."""
+@dataclass
+class Section:
+    """One table of the report: its heading and its markdown body."""
+
+    heading: str
+    body: str
+
+
+def report_sections(table: pd.DataFrame, reps: int = 2000) -> dict[str, Section]:
+    """The report's tables by key: ``final``, ``means``, then ``growth`` (GQN runs only) and ``iqm`` (two tasks
+    or more) where the table has them."""
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
-    sections = ["### Final greedy evaluation per run\n"]
+    sections: dict[str, Section] = {}
     columns = {
         "env": "env",
         "algo": "algo",
@@ -145,19 +154,17 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
     shown = final[list(columns)].rename(columns=columns)
     shown["env"] = shown["env"].str.replace("dm_control/", "", regex=False)
     shown["bins"] = shown["bins"].map(lambda bins: "-" if pd.isna(bins) else str(int(bins)))
-    sections.append(_markdown(shown))
+    sections["final"] = Section("Final greedy evaluation per run", _markdown(shown))
 
     means = final.groupby(["env", "penalty", "algo"]).agg(
         seeds=("seed", "count"), mean_return=("return", "mean"), mean_SM=("smoothness", "mean")
     )
     means = means.reset_index()
     means["env"] = means["env"].str.replace("dm_control/", "", regex=False)
-    sections.append("\n### Mean over seeds\n")
-    sections.append(_markdown(means))
+    sections["means"] = Section("Mean over seeds", _markdown(means))
 
     checks = growth_checks(table)
     if checks:
-        sections.append("\n### Returns around each growth (held: after >= 70 % of before, or within 50 below 100)\n")
         rows = [
             {
                 "env": check.env.replace("dm_control/", ""),
@@ -170,7 +177,9 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
             }
             for check in checks
         ]
-        sections.append(_markdown(pd.DataFrame(rows)))
+        sections["growth"] = Section(
+            "Returns around each growth (held: after >= 70 % of before, or within 50 below 100)", _markdown(pd.DataFrame(rows))
+        )
 
     scores, tasks = normalized_final_scores(table)
     if len(tasks) > 1 and scores:
@@ -185,9 +194,25 @@ def report(table: pd.DataFrame, reps: int = 2000) -> str:
             for algo in sorted(scores, key=lambda algo: -float(estimates[algo][0]))
         ]
         names = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks)
-        sections.append(f"\n### IQM of min-max normalized final return across {len(tasks)} tasks ({names})\n")
-        sections.append(_markdown(pd.DataFrame(rows)))
-    return "\n".join(sections) + "\n"
+        heading = f"IQM of min-max normalized final return across {len(tasks)} tasks ({names})"
+        sections["iqm"] = Section(heading, _markdown(pd.DataFrame(rows)))
+    return sections
+
+
+def report(table: pd.DataFrame, reps: int = 2000) -> str:
+    """All tables as one markdown text."""
+    return "\n\n".join(f"### {section.heading}\n\n{section.body}" for section in report_sections(table, reps).values()) + "\n"
+
+
+def plot_table(table: pd.DataFrame, out: Path) -> list[Path]:
+    """The suite's figures (sb3_gqn.plots.plot_suite) for an in-memory table, drawn into ``out``."""
+    from sb3_gqn.plots import plot_suite
+
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as scratch:  # not in ``out``: a glob over results.csv files would find it
+        combined = Path(scratch) / "results.csv"
+        table.to_csv(combined, index=False)
+        return plot_suite(combined, out)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -219,14 +244,8 @@ def main(argv: list[str] | None = None) -> int:
         table = table[table["algo"].isin(args.algos)]
     print(report(table, args.reps))
     if args.plots is not None:
-        from sb3_gqn.plots import plot_suite
-
-        args.plots.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory() as scratch:  # not in --plots: a glob over results.csv files would find it
-            combined = Path(scratch) / "results.csv"
-            table.to_csv(combined, index=False)
-            for path in plot_suite(combined, args.plots):
-                print(f"plot: {path}")
+        for path in plot_table(table, args.plots):
+            print(f"plot: {path}")
     return 0
 
 

@@ -8,13 +8,11 @@ Run from the repository root after extending a table with the comparison runner.
 
 from __future__ import annotations
 
-import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from sb3_gqn.plots import plot_suite
-from sb3_gqn.report import as_shipped, load, report
+from sb3_gqn.report import as_shipped, load, plot_table, report_sections
 
 RESULTS = Path("docs/results")
 README = Path("README.md")
@@ -33,45 +31,22 @@ PROBES = [
 MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
 
 
-def sections(text: str) -> dict[str, str]:
-    """``report``'s markdown split at its ``### `` headings: ``{heading: body}``."""
-    found = {}
-    for part in re.split(r"^### ", text, flags=re.M)[1:]:
-        heading, body = part.split("\n", 1)
-        found[heading.strip()] = body.strip()
-    return found
-
-
-def pick(found: dict[str, str], prefix: str) -> tuple[str, str]:
-    """The (heading, body) whose heading starts with ``prefix``."""
-    return next((heading, body) for heading, body in found.items() if heading.startswith(prefix))
-
-
 def main_comparison() -> str:
     table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])
     for env, suffix in SHIPPED.items():
         table = as_shipped(table, env, suffix)
-    with_baselines = table[table["algo"].isin([*MAIN_ALGOS, *BASELINES])]
-    table = table[table["algo"].isin(MAIN_ALGOS)]
-    found = sections(report(table, reps=2000))
-    plot_table = RESULTS / "main" / "shipped.csv"
-    with_baselines.to_csv(plot_table, index=False)  # the figures show SAC where it ran (no IQM: one task)
-    try:
-        plot_suite(plot_table, RESULTS / "main")
-    finally:
-        plot_table.unlink()
-    iqm_heading, iqm = pick(found, "IQM")
-    growth_heading, growth = pick(found, "Returns around each growth")
+    plot_table(table[table["algo"].isin([*MAIN_ALGOS, *BASELINES])], RESULTS / "main")  # SAC shown where it ran
+    sections = report_sections(table[table["algo"].isin(MAIN_ALGOS)], reps=2000)
     return "\n\n".join(
         [
             "**Final greedy evaluation, gqn-adaptive vs gqn-linear vs decqn-9 vs decqn-2 (shipped entries)**",
-            pick(found, "Final greedy evaluation")[1],
+            sections["final"].body,
             "**Mean over seeds**",
-            pick(found, "Mean over seeds")[1],
-            f"**{growth_heading}**; an evaluation at the step of a growth is already after it",
-            growth,
-            f"**{iqm_heading}**",
-            iqm,
+            sections["means"].body,
+            f"**{sections['growth'].heading}**; an evaluation at the step of a growth is already after it",
+            sections["growth"].body,
+            f"**{sections['iqm'].heading}**",
+            sections["iqm"].body,
             "\n".join(
                 f"![{path.stem.replace('_', ' ')}](docs/results/main/{path.name})"
                 for path in sorted((RESULTS / "main").glob("learning_curves_*.png"))
@@ -90,8 +65,8 @@ def probes() -> str:
     # walker's shipped configuration tried on tasks that do not ship it (not on SHIPPED's: those runs are the main ones)
     elsewhere = ~table["env"].isin(list(SHIPPED)) & table["algo"].str.endswith(tuple(SHIPPED.values()))
     table = table[table["algo"].isin([*PROBES, *BASELINES]) | table["algo"].str.endswith("(earlier entry)") | elsewhere]
-    found = sections(report(table, reps=100))
-    return "\n\n".join([pick(found, "Final greedy evaluation")[1], "**Mean over seeds**", pick(found, "Mean over seeds")[1]])
+    sections = report_sections(table, reps=100)
+    return "\n\n".join([sections["final"].body, "**Mean over seeds**", sections["means"].body])
 
 
 BLOCKS: dict[str, Callable[[], str]] = {"issue-11-main": main_comparison, "issue-11-probes": probes}
