@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
@@ -36,6 +37,21 @@ from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
 from sb3_gqn.wrappers import BinGrid
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
+
+
+def clip_grad_norm(parameters: Iterable[th.nn.Parameter], max_norm: float) -> th.Tensor:
+    """``th.nn.utils.clip_grad_norm_`` (2-norm over all gradients), with the same result, minus its cost when there
+    is nothing to clip.
+
+    PyTorch multiplies every gradient by ``min(max_norm / (norm + 1e-6), 1)`` unconditionally, to avoid a device
+    sync; on CPU the comparison is free and the multiplication by 1.0 (with its grouping of the tensors) cost
+    ~0.1 ms of a ~4.5 ms cartpole update. Elsewhere (CUDA) this is ``clip_grad_norm_``. Returns the total norm.
+    """
+    with_grad = [parameter for parameter in parameters if parameter.grad is not None]
+    total_norm = th.nn.utils.get_total_norm([parameter.grad for parameter in with_grad])
+    if total_norm.device.type != "cpu" or not total_norm + 1e-6 <= max_norm:  # NaN norms go on to PyTorch too
+        th.nn.utils.clip_grads_with_norm_(with_grad, max_norm, total_norm)
+    return total_norm
 
 
 def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
@@ -516,7 +532,7 @@ class GQN(OffPolicyAlgorithm):
             self.policy.optimizer.zero_grad(set_to_none=True)
             loss.backward()
             if self.max_grad_norm is not None:
-                th.nn.utils.clip_grad_norm_(self.q_net.parameters(), self.max_grad_norm)
+                clip_grad_norm(self.q_net.parameters(), self.max_grad_norm)
             self.policy.optimizer.step()
             if prioritized:  # the TD errors become the sampled transitions' new priorities
                 # (after the step: the backward pass still finds the forward's activations in cache, ~3 % faster)

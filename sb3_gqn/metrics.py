@@ -40,6 +40,48 @@ def smoothness(actions: np.ndarray, freq: float) -> float:
     return float(per_dimension.mean())
 
 
+@dataclass
+class BinUsage:
+    """How a rollout's actions use a grid of bin values (see :func:`bin_usage`)."""
+
+    #: share of action entries nearest to each bin value, in the grid's order (sums to 1)
+    shares: np.ndarray
+    #: share of action entries at the grid's ends (bang-bang actions)
+    extreme_share: float
+    #: share of (step, dimension) pairs whose action differs from the previous step's
+    change_rate: float
+    #: share of consecutive step pairs, per dimension, whose changes have opposite signs (chatter: up, then
+    #: straight back down)
+    reversal_rate: float
+
+
+def bin_usage(actions: np.ndarray, bin_values: np.ndarray) -> BinUsage:
+    """Where on the bin grid a policy acts and how often it switches: the diagnostic behind SM for discrete agents.
+
+    :param actions: ``(T,)`` or ``(T, M)`` actions, ``T >= 3``, on the scale of ``bin_values`` (e.g. normalized
+        to ``[-1, 1]`` with :func:`normalized_actions`); continuous actions count for their nearest bin
+    :param bin_values: the ``K >= 2`` grid values in increasing order, e.g. ``np.linspace(-1, 1, 9)``
+    """
+    actions = np.asarray(actions, dtype=np.float64)
+    if actions.ndim == 1:
+        actions = actions[:, None]
+    bin_values = np.asarray(bin_values, dtype=np.float64)
+    if actions.ndim != 2 or actions.shape[0] < 3:
+        raise ValueError(f"actions must be (T,) or (T, M) with T >= 3 samples, got shape {actions.shape}")
+    if bin_values.ndim != 1 or bin_values.size < 2 or not np.all(np.diff(bin_values) > 0):
+        raise ValueError(f"bin_values must be >= 2 increasing values, got {bin_values}")
+    if not np.all(np.isfinite(actions)):
+        raise ValueError("actions contain NaN or infinite values")
+    nearest = np.abs(actions[..., None] - bin_values).argmin(axis=-1)
+    changes = np.diff(actions, axis=0)
+    return BinUsage(
+        shares=np.bincount(nearest.ravel(), minlength=bin_values.size) / nearest.size,
+        extreme_share=float(np.isin(nearest, (0, bin_values.size - 1)).mean()),
+        change_rate=float((changes != 0).mean()),
+        reversal_rate=float((changes[1:] * changes[:-1] < 0).mean()),
+    )
+
+
 def control_frequency(env: gym.Env) -> float | None:
     """The env's control frequency in Hz (1 / control timestep), or ``None`` if it does not say.
 

@@ -3,7 +3,7 @@
     python -m sb3_gqn.report docs/results/*/results.csv               # tables for the README
     python -m sb3_gqn.report docs/results/*/results.csv --plots docs/results/all   # plus the cross-task IQM plot
     python -m sb3_gqn.report docs/results/*/results.csv --algos gqn-adaptive decqn-9 decqn-2   # only these
-    python -m sb3_gqn.report ... --shipped dm_control/walker-walk-v0=+layernorm+1update   # walker's entries
+    python -m sb3_gqn.report ... --shipped dm_control/finger-spin-v0=+layernorm+1update   # finger's entries
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 

@@ -142,26 +142,34 @@ def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
         )
 
 
-def test_walker_runs_of_the_shipped_entries_are_the_layernorm_1update_variants():
-    """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker runs under
-    the plain names: that holds only while they train exactly what the shipped walker entries train."""
-    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, _shipped_entry, run_overrides
+def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update_variants():
+    """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
+    under the plain names: that holds only while they train exactly what the shipped entries train."""
+    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, _shipped_entry, run_overrides
 
-    walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
+    walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
     def trained(algo: str, env: str) -> dict:
         zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
         return {**_shipped_entry(zoo_algo, env), **overrides}
 
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
-        assert trained(algo, walker) == trained(f"{algo}+layernorm+1update", walker)
-        assert trained(algo, walker)["train_freq"] == 1
-        assert trained(algo, finger)["train_freq"] == 2 and "policy_kwargs" not in trained(algo, finger)
-    # The ablation keeps the walker entry it was recorded with (MLP torso, 1 update per 2 steps) ...
-    before = trained("gqn-before+shared", walker)
-    assert before["train_freq"] == 2 and before["policy_kwargs"] is None and before["exploration"] == "shared"
-    # ... and finger's entry, unchanged by issue 11
-    assert run_overrides(RunSpec("gqn-before", finger, 0.1, 0, 1000))[1] == BEFORE_GROWTH_FIXES
+        for env in (walker, finger):
+            assert trained(algo, env) == trained(f"{algo}+layernorm+1update", env)
+            assert trained(algo, env)["train_freq"] == 1
+        # cartpole (the main job) keeps the plain MLP and 1 update per 2 env steps
+        assert trained(algo, cartpole)["train_freq"] == 2 and "policy_kwargs" not in trained(algo, cartpole)
+    # The torso-alone probes and the ablation keep what they were recorded with (1 update per 2 steps; the MLP torso)
+    for algo in ("gqn-adaptive+layernorm", "decqn-9+layernorm"):
+        assert trained(algo, walker)["train_freq"] == 2 and trained(algo, walker)["policy_kwargs"] == REFERENCE_TORSO
+    for env in (walker, finger):
+        before = trained("gqn-before+shared", env)
+        assert before["train_freq"] == 2 and before["policy_kwargs"] is None and before["exploration"] == "shared"
+        assert run_overrides(RunSpec("gqn-before", env, 0.1, 0, 1000))[1] == {
+            "train_freq": 2,
+            "policy_kwargs": None,
+            **BEFORE_GROWTH_FIXES,
+        }
 
 
 @pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from sb3_gqn.metrics import control_frequency, normalized_actions, rollout_figures, smoothness
+from sb3_gqn.metrics import bin_usage, control_frequency, normalized_actions, rollout_figures, smoothness
 from sb3_gqn.wrappers import ActionPenalty
 
 
@@ -88,3 +88,31 @@ def test_normalized_actions_and_box_only():
     np.testing.assert_allclose(normalized_actions(np.array([[-2.0, 5.0], [1.0, 10.0]]), space), [[-1, 0], [0.5, 1]])
     with pytest.raises(TypeError, match="Box"):
         rollout_figures(ScriptedPolicy(), gym.make("CartPole-v1"))
+
+
+def test_bin_usage_by_hand():
+    # Two dimensions on the 5-bin grid {-1, -0.5, 0, 0.5, 1}; 0.4 counts for its nearest bin, 0.5
+    actions = np.array([[1.0, 0.0], [1.0, -0.5], [0.0, -0.5], [1.0, 0.4]])
+    usage = bin_usage(actions, np.linspace(-1, 1, 5))
+    # nearest bins: dimension 0 -> 4, 4, 2, 4; dimension 1 -> 2, 1, 1, 3: counts 0, 2, 2, 1, 3 of 8
+    np.testing.assert_allclose(usage.shares, [0, 2 / 8, 2 / 8, 1 / 8, 3 / 8])
+    assert usage.extreme_share == pytest.approx(3 / 8)  # the three 1.0 entries
+    # changes: dimension 0 -> 0, -1, +1; dimension 1 -> -0.5, 0, +0.9: 4 of 6 are changes
+    assert usage.change_rate == pytest.approx(4 / 6)
+    # consecutive change pairs: (0, -1), (-1, +1), (-0.5, 0), (0, +0.9): one reversal in 4
+    assert usage.reversal_rate == pytest.approx(1 / 4)
+
+
+def test_bin_usage_of_a_bang_bang_square_wave_and_bad_input():
+    square = np.tile([1.0, 1.0, -1.0, -1.0], 25)
+    usage = bin_usage(square, np.linspace(-1, 1, 9))
+    assert usage.extreme_share == 1.0 and usage.shares[[0, -1]].tolist() == [0.5, 0.5]
+    assert usage.change_rate == pytest.approx(49 / 99)  # a change every second step
+    assert usage.reversal_rate == 0.0  # each change is followed by a hold, never straight back
+    assert bin_usage(np.tile([1.0, -1.0], 50), np.linspace(-1, 1, 3)).reversal_rate == 1.0
+    with pytest.raises(ValueError, match="T >= 3"):
+        bin_usage(np.zeros((2, 1)), np.linspace(-1, 1, 3))
+    with pytest.raises(ValueError, match="increasing"):
+        bin_usage(np.zeros(5), np.array([1.0, 0.0]))
+    with pytest.raises(ValueError, match="NaN"):
+        bin_usage(np.array([0.0, np.nan, 1.0]), np.linspace(-1, 1, 3))

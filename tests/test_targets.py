@@ -65,3 +65,31 @@ def test_double_q_target_with_sb3_n_step_buffer():
     q = th.ones(2, 1, 3)
     y = double_q_target(q, q * 7.0, samples.rewards, samples.dones, samples.discounts, th.ones(3, dtype=th.bool))
     assert y.tolist() == pytest.approx([3.0, 4.0])
+
+
+@pytest.mark.parametrize("max_norm", [10.0, 5.0 + 1e-6, 2.5, 0.1])
+def test_clip_grad_norm_by_hand_and_equal_to_pytorch(max_norm):
+    from sb3_gqn.gqn import clip_grad_norm
+
+    def parameters_with_grads() -> list[th.nn.Parameter]:
+        first, second, third = th.nn.Parameter(th.zeros(2)), th.nn.Parameter(th.zeros(1)), th.nn.Parameter(th.zeros(3))
+        first.grad, second.grad = th.tensor([3.0, 0.0]), th.tensor([4.0])  # third has no gradient
+        return [first, second, third]
+
+    ours, theirs = parameters_with_grads(), parameters_with_grads()
+    assert clip_grad_norm(iter(ours), max_norm).item() == pytest.approx(5.0)  # sqrt(3^2 + 4^2)
+    th.nn.utils.clip_grad_norm_(theirs, max_norm)
+    scale = min(max_norm / (5.0 + 1e-6), 1.0)
+    for mine, pytorch, expected in zip(ours[:2], theirs[:2], ([3.0 * scale, 0.0], [4.0 * scale])):
+        assert th.equal(mine.grad, pytorch.grad)  # bit for bit, clipped or not
+        np.testing.assert_allclose(mine.grad.numpy(), expected, rtol=1e-6)
+    assert ours[2].grad is None
+
+
+def test_clip_grad_norm_passes_a_nan_norm_on_like_pytorch():
+    from sb3_gqn.gqn import clip_grad_norm
+
+    parameter = th.nn.Parameter(th.zeros(2))
+    parameter.grad = th.tensor([float("nan"), 1.0])
+    assert th.isnan(clip_grad_norm([parameter], 1.0))
+    assert th.isnan(parameter.grad).all()  # multiplied by a NaN coefficient, as clip_grad_norm_ does

@@ -17,8 +17,9 @@ from sb3_gqn.report import as_shipped, load, report_sections
 
 RESULTS = Path("docs/results")
 README = Path("README.md")
-#: walker-walk's shipped entries (gqn.yml, decqn.yml) are the runner's ``+layernorm+1update`` variants
-SHIPPED = {"dm_control/walker-walk-v0": "+layernorm+1update"}
+#: walker-walk's and finger-spin's shipped entries (gqn.yml, decqn.yml) are the runner's ``+layernorm+1update``
+#: variants
+SHIPPED = {"dm_control/walker-walk-v0": "+layernorm+1update", "dm_control/finger-spin-v0": "+layernorm+1update"}
 MAIN_ALGOS = ["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"]
 BASELINES = ["sac"]
 PROBES = [
@@ -74,7 +75,46 @@ def probes() -> str:
     return "\n\n".join([sections["final"].body, "**Mean over seeds**", sections["means"].body])
 
 
-BLOCKS: dict[str, Callable[[], str]] = {"issue-11-main": main_comparison, "issue-11-probes": probes}
+def shipped_name(algo: str, env: str) -> str | None:
+    """The name a run has in the main comparison (on SHIPPED's tasks its variants stand for the plain names, and
+    the plain-name runs are the earlier entry's), or None for a run outside it. Baselines keep their names."""
+    if algo in BASELINES:
+        return algo
+    suffix = SHIPPED.get(env, "")
+    plain = algo.removesuffix(suffix) if suffix and algo.endswith(suffix) else None if suffix else algo
+    return plain if plain in MAIN_ALGOS else None
+
+
+def final_policies() -> str:
+    """The final greedy policies bin by bin (``docs/results/final_policies.csv``, written by ``final_policies.py``
+    from the runs' saved models, which are not committed)."""
+    import pandas as pd
+
+    table = pd.read_csv(RESULTS / "final_policies.csv")
+    table["algo"] = [shipped_name(algo, env) for algo, env in zip(table["algo"], table["env"])]
+    table = table.dropna(subset=["algo"]).sort_values(["env", "algo", "seed"])
+    shares = [column for column in table.columns if column.startswith("share_")]
+    header = ["env", "algo", "seed", "task return", "SM (std over episodes)", "at +-1", "changes", "reversals"]
+    lines = [
+        "| " + " | ".join([*header, "share per bin, -1 ... +1"]) + " |",
+        "| " + " | ".join(["---"] * 3 + ["---:"] * 5 + ["---"]) + " |",
+    ]
+    for record in table.to_dict("records"):
+        lines.append(
+            f"| {record['env'].split('/')[-1]} | {record['algo']} | {record['seed']} | {record['task_return']:.0f} | "
+            f"{record['smoothness']:.4f} ({record['smoothness_std']:.4f}) | {record['extreme_share']:.2f} | "
+            f"{record['change_rate']:.2f} | {record['reversal_rate']:.2f} | "
+            + " ".join(f"{record[column]:.2f}" for column in shares)
+            + " |"
+        )
+    return "\n".join(lines)
+
+
+BLOCKS: dict[str, Callable[[], str]] = {
+    "issue-11-main": main_comparison,
+    "issue-11-probes": probes,
+    "issue-11-final-policies": final_policies,
+}
 
 
 def replace_block(text: str, name: str, body: str) -> str:
