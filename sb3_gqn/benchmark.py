@@ -182,6 +182,18 @@ def untrained_runs(specs: list[RunSpec]) -> list[str]:
     return list(warnings.values())
 
 
+def make_eval_env(spec: RunSpec) -> gym.Env:
+    """A single env for the run's greedy evaluations: ``spec.env`` with its entry's wrappers, the action penalty
+    set to ``spec.penalty``. Call :func:`sb3_gqn.zoo.register` first for the dm_control and Meta-World ids."""
+    from rl_zoo3.utils import get_wrapper_class
+
+    zoo_algo, _ = run_overrides(spec)
+    wrappers = penalized_wrappers(_shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
+    wrapper = get_wrapper_class({"env_wrapper": wrappers})
+    env = gym.make(spec.env)
+    return wrapper(env) if wrapper is not None else env
+
+
 def _shipped_entry(zoo_algo: str, env_id: str) -> dict[str, Any]:
     import yaml
 
@@ -283,7 +295,6 @@ def run(
     run_dir.mkdir(parents=True)
     import torch as th
     from rl_zoo3.exp_manager import ExperimentManager
-    from rl_zoo3.utils import get_wrapper_class
 
     from sb3_gqn.plots import save_q_snapshot
     from sb3_gqn.zoo import register, shipped_hyperparams
@@ -291,8 +302,7 @@ def run(
     th.set_num_threads(threads)
     register()
     zoo_algo, overrides = run_overrides(spec)
-    entry = _shipped_entry(zoo_algo, spec.env)
-    wrappers = penalized_wrappers(entry.get("env_wrapper"), spec.penalty)
+    wrappers = penalized_wrappers(_shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
     manager = ExperimentManager(
         argparse.Namespace(),
         zoo_algo,
@@ -307,9 +317,7 @@ def run(
         config=str(shipped_hyperparams(zoo_algo)),
     )
     model, _ = manager.setup_experiment()  # type: ignore[misc]
-    wrapper = get_wrapper_class({"env_wrapper": wrappers})
-    eval_env = gym.make(spec.env)
-    eval_env = wrapper(eval_env) if wrapper is not None else eval_env
+    eval_env = make_eval_env(spec)
     manager.callbacks.append(BenchmarkCallback(spec, run_dir, eval_env, eval_freq, eval_episodes, report_progress))
     if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
         manager.callbacks.append(save_q_snapshot(run_dir))

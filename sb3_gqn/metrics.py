@@ -129,6 +129,61 @@ class SmoothnessFigures:
         return asdict(self)
 
 
+@dataclass
+class Episode:
+    """One greedy rollout: its actions rescaled to ``[-1, 1]`` (``(T, M)``), its task return (without the action
+    penalty) and the return the agent was trained on."""
+
+    actions: np.ndarray
+    task_return: float
+    return_: float
+
+
+def rollout_episodes(
+    model: Any, env: gym.Env, n_episodes: int = 5, deterministic: bool = True, seed: int | None = None
+) -> list[Episode]:
+    """Run ``model`` (anything with SB3's ``predict``) for ``n_episodes`` on a single (non-vectorized) ``env`` with a
+    ``Box`` action space and keep each episode's rescaled actions and returns.
+
+    :param seed: seed of the first episode's reset (episode k uses ``seed + k``)
+    """
+    if not isinstance(env.action_space, spaces.Box):
+        raise TypeError(f"Smoothness figures need a Box action space, got {env.action_space}")
+    episodes = []
+    for episode in range(n_episodes):
+        observation, _ = env.reset(seed=None if seed is None else seed + episode)
+        actions, task_return, total_return, done = [], 0.0, 0.0, False
+        while not done:
+            action, _ = model.predict(observation, deterministic=deterministic)
+            observation, reward, terminated, truncated, info = env.step(action)
+            actions.append(np.asarray(action, dtype=np.float64).reshape(-1))
+            total_return += float(reward)
+            task_return += float(info.get("task_reward", reward))
+            done = terminated or truncated
+        episodes.append(Episode(normalized_actions(np.stack(actions), env.action_space), task_return, total_return))
+    return episodes
+
+
+def episode_figures(episode: Episode, freq: float) -> SmoothnessFigures:
+    """:class:`SmoothnessFigures` of one episode (``episodes=1``), SM at sampling frequency ``freq``."""
+    scaled = episode.actions
+    return SmoothnessFigures(
+        task_return=episode.task_return,
+        penalty=float((scaled**2).sum()),
+        action_magnitude=float(np.abs(scaled).mean()),
+        action_change=float(np.abs(np.diff(scaled, axis=0)).mean()) if len(scaled) > 1 else 0.0,
+        smoothness=smoothness(scaled, freq) if len(scaled) > 1 else 0.0,
+        return_=episode.return_,
+        episode_length=float(len(scaled)),
+        freq=float(freq),
+        episodes=1,
+    )
+
+
+#: the per-episode fields of SmoothnessFigures that rollout_figures averages, in the class's order
+_MEAN_FIELDS = ("task_return", "penalty", "action_magnitude", "action_change", "smoothness", "return_", "episode_length")
+
+
 def rollout_figures(
     model: Any,
     env: gym.Env,
@@ -144,31 +199,7 @@ def rollout_figures(
         (SM then counts cycles per step)
     :param seed: seed of the first episode's reset (episode k uses ``seed + k``)
     """
-    if not isinstance(env.action_space, spaces.Box):
-        raise TypeError(f"Smoothness figures need a Box action space, got {env.action_space}")
     freq = freq or control_frequency(env) or 1.0
-    per_episode: list[list[float]] = []
-    for episode in range(n_episodes):
-        observation, _ = env.reset(seed=None if seed is None else seed + episode)
-        actions, task_return, total_return, done = [], 0.0, 0.0, False
-        while not done:
-            action, _ = model.predict(observation, deterministic=deterministic)
-            observation, reward, terminated, truncated, info = env.step(action)
-            actions.append(np.asarray(action, dtype=np.float64).reshape(-1))
-            total_return += float(reward)
-            task_return += float(info.get("task_reward", reward))
-            done = terminated or truncated
-        scaled = normalized_actions(np.stack(actions), env.action_space)
-        per_episode.append(
-            [
-                task_return,
-                float((scaled**2).sum()),
-                float(np.abs(scaled).mean()),
-                float(np.abs(np.diff(scaled, axis=0)).mean()) if len(scaled) > 1 else 0.0,
-                smoothness(scaled, freq) if len(scaled) > 1 else 0.0,
-                total_return,
-                float(len(scaled)),
-            ]
-        )
-    means = np.mean(per_episode, axis=0)
+    figures = [episode_figures(episode, freq) for episode in rollout_episodes(model, env, n_episodes, deterministic, seed)]
+    means = np.mean([[getattr(figure, name) for name in _MEAN_FIELDS] for figure in figures], axis=0)
     return SmoothnessFigures(*map(float, means), freq=float(freq), episodes=n_episodes)

@@ -22,23 +22,28 @@ import json
 import sys
 from pathlib import Path
 
-import gymnasium as gym
 import numpy as np
+
+from sb3_gqn.benchmark import RunSpec
 
 RESULTS = Path("docs/results")
 OUT = RESULTS / "final_policies.csv"
 EPISODES, FIRST_SEED = 10, 20_000
 BIN_VALUES = np.linspace(-1.0, 1.0, 9)
+#: CSV columns from sb3_gqn.metrics.SmoothnessFigures, averaged over the episodes
+FIGURES = {
+    "task_return": "task_return",
+    "action_penalty": "penalty",
+    "action_magnitude": "action_magnitude",
+    "action_change": "action_change",
+    "smoothness": "smoothness",
+}
 COLUMNS = [
     "table",
     "algo",
     "env",
     "seed",
-    "task_return",
-    "action_penalty",
-    "action_magnitude",
-    "action_change",
-    "smoothness",
+    *FIGURES,
     "smoothness_std",
     "extreme_share",
     "change_rate",
@@ -47,54 +52,35 @@ COLUMNS = [
 ]
 
 
-def probe(run_dir: Path) -> dict[str, float | str]:
+def run_spec(run_dir: Path) -> RunSpec:
+    """The run's spec, as the runner recorded it in ``done.json``."""
+    return RunSpec(**json.loads((run_dir / "done.json").read_text())["spec"])
+
+
+def probe(run_dir: Path, spec: RunSpec) -> dict[str, float | str]:
     import torch as th
-    from rl_zoo3.utils import get_wrapper_class
     from stable_baselines3 import SAC
 
     from sb3_gqn import GQN
-    from sb3_gqn.benchmark import RunSpec, _shipped_entry, penalized_wrappers, run_overrides
-    from sb3_gqn.metrics import bin_usage, control_frequency, normalized_actions, smoothness
+    from sb3_gqn.benchmark import make_eval_env, run_overrides
+    from sb3_gqn.metrics import bin_usage, control_frequency, episode_figures, rollout_episodes
     from sb3_gqn.zoo import register
 
     th.set_num_threads(1)
     register()  # the dm_control and Meta-World ids
-    spec = RunSpec(**json.loads((run_dir / "done.json").read_text())["spec"])
-    zoo_algo, _ = run_overrides(spec)
-    wrappers = penalized_wrappers(_shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
-    env = get_wrapper_class({"env_wrapper": wrappers})(gym.make(spec.env))
-    model = (SAC if zoo_algo == "sac" else GQN).load(run_dir / "model.zip", device="cpu")
+    env = make_eval_env(spec)
+    model = (SAC if run_overrides(spec)[0] == "sac" else GQN).load(run_dir / "model.zip", device="cpu")
     freq = control_frequency(env) or 1.0
-    episodes, figures = [], []
-    for episode in range(EPISODES):
-        observation, _ = env.reset(seed=FIRST_SEED + episode)
-        actions, task_return, done = [], 0.0, False
-        while not done:
-            action, _ = model.predict(observation, deterministic=True)
-            observation, reward, terminated, truncated, info = env.step(action)
-            actions.append(np.asarray(action, dtype=np.float64).reshape(-1))
-            task_return += float(info.get("task_reward", reward))
-            done = terminated or truncated
-        scaled = normalized_actions(np.stack(actions), env.action_space)
-        episodes.append(scaled)
-        figures.append(
-            [
-                task_return,
-                float((scaled**2).sum()),
-                float(np.abs(scaled).mean()),
-                float(np.abs(np.diff(scaled, axis=0)).mean()),
-                smoothness(scaled, freq),
-            ]
-        )
-    means = np.mean(figures, axis=0)
-    usage = [bin_usage(actions, BIN_VALUES) for actions in episodes]
+    episodes = rollout_episodes(model, env, EPISODES, seed=FIRST_SEED)
+    figures = [episode_figures(episode, freq) for episode in episodes]
+    usage = [bin_usage(episode.actions, BIN_VALUES) for episode in episodes]
     return {
         "table": run_dir.parent.parent.name,
         "algo": spec.algo,
         "env": spec.env,
         "seed": spec.seed,
-        **dict(zip(COLUMNS[4:9], map(float, means))),
-        "smoothness_std": float(np.std([row[4] for row in figures])),
+        **{column: float(np.mean([getattr(figure, field) for figure in figures])) for column, field in FIGURES.items()},
+        "smoothness_std": float(np.std([figure.smoothness for figure in figures])),
         **{
             key: float(np.mean([getattr(episode, key) for episode in usage]))
             for key in ("extreme_share", "change_rate", "reversal_rate")
@@ -113,17 +99,17 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     every_table = sorted(path.parent for path in RESULTS.glob("*/results.csv"))
     tables = [RESULTS / name for name in args.tables] if args.tables else every_table
-    run_dirs = [
-        run_dir
+    runs = [
+        (run_dir, run_spec(run_dir))
         for table in tables
         for run_dir in sorted((table / "runs").glob("*"))
-        if (run_dir / "model.zip").is_file()
-        and (run_dir / "done.json").is_file()
-        and json.loads((run_dir / "done.json").read_text())["spec"]["algo"].split("+")[0] in args.algos
+        if (run_dir / "model.zip").is_file() and (run_dir / "done.json").is_file()
     ]
     rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
-    for run_dir in run_dirs:
-        row = probe(run_dir)
+    for run_dir, spec in runs:
+        if spec.algo.split("+")[0] not in args.algos:
+            continue
+        row = probe(run_dir, spec)
         rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
         sm, extremes = float(row["smoothness"]), float(row["extreme_share"])
         print(f"{row['table']} {row['algo']} seed {row['seed']}: SM {sm:.4f}, extremes {extremes:.2f}")

@@ -12,6 +12,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+import pandas as pd
+
 from sb3_gqn.plots import aggregate, learning_curves, smoothness_radar
 from sb3_gqn.report import as_shipped, load, report_sections
 
@@ -33,10 +35,15 @@ PROBES = [
 MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
 
 
-def main_comparison() -> str:
-    table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])
+def shipped(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs."""
     for env, suffix in SHIPPED.items():
         table = as_shipped(table, env, suffix)
+    return table
+
+
+def main_comparison() -> str:
+    table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
     main, with_baselines = table[table["algo"].isin(MAIN_ALGOS)], table[table["algo"].isin([*MAIN_ALGOS, *BASELINES])]
     # Curves and radars show SAC where it ran; the IQM figure normalizes over the same runs as the IQM table
     learning_curves(with_baselines, RESULTS / "main")
@@ -75,24 +82,11 @@ def probes() -> str:
     return "\n\n".join([sections["final"].body, "**Mean over seeds**", sections["means"].body])
 
 
-def shipped_name(algo: str, env: str) -> str | None:
-    """The name a run has in the main comparison (on SHIPPED's tasks its variants stand for the plain names, and
-    the plain-name runs are the earlier entry's), or None for a run outside it. Baselines keep their names."""
-    if algo in BASELINES:
-        return algo
-    suffix = SHIPPED.get(env, "")
-    plain = algo.removesuffix(suffix) if suffix and algo.endswith(suffix) else None if suffix else algo
-    return plain if plain in MAIN_ALGOS else None
-
-
 def final_policies() -> str:
     """The final greedy policies bin by bin (``docs/results/final_policies.csv``, written by ``final_policies.py``
     from the runs' saved models, which are not committed)."""
-    import pandas as pd
-
-    table = pd.read_csv(RESULTS / "final_policies.csv")
-    table["algo"] = [shipped_name(algo, env) for algo, env in zip(table["algo"], table["env"])]
-    table = table.dropna(subset=["algo"]).sort_values(["env", "algo", "seed"])
+    table = shipped(pd.read_csv(RESULTS / "final_policies.csv"))  # as in the main comparison, and SAC
+    table = table[table["algo"].isin([*MAIN_ALGOS, *BASELINES])].sort_values(["env", "algo", "seed"])
     shares = [column for column in table.columns if column.startswith("share_")]
     header = ["env", "algo", "seed", "task return", "SM (std over episodes)", "at +-1", "changes", "reversals"]
     lines = [
