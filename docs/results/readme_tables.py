@@ -104,10 +104,40 @@ def final_policies() -> str:
     return "\n".join(lines)
 
 
+def bin_interpolation() -> str:
+    """How the opened bins' final utilities relate to their neighbours (``docs/results/bin_interpolation.csv``,
+    written by ``bin_interpolation.py`` from the runs' saved models): per task and agent of the main comparison,
+    the mean over seeds of each growth step's interpolation bias and error, as fractions of the utility range."""
+    table = shipped(pd.read_csv(RESULTS / "bin_interpolation.csv"))
+    table = table[table["algo"].isin(MAIN_ALGOS)]
+    summary = (
+        table.groupby(["env", "algo", "growth_step"])
+        .agg(
+            seeds=("seed", "count"),
+            linear_bias=("linear_bias", "mean"),
+            min_bias=("linear_bias", "min"),
+            max_bias=("linear_bias", "max"),
+            linear_error=("linear_error", "mean"),
+            quadratic_error=("quadratic_error", "mean"),
+        )
+        .reset_index()
+    )
+    header = ["env", "algo", "growth step", "seeds", "linear bias, mean [min, max]", "linear error", "quadratic error"]
+    lines = ["| " + " | ".join(header) + " |", "| " + " | ".join(["---"] * 3 + ["---:"] * 4) + " |"]
+    for record in summary.to_dict("records"):
+        lines.append(
+            f"| {record['env'].split('/')[-1]} | {record['algo']} | {record['growth_step']} | {record['seeds']} | "
+            f"{record['linear_bias']:+.3f} [{record['min_bias']:+.3f}, {record['max_bias']:+.3f}] | "
+            f"{record['linear_error']:.3f} | {record['quadratic_error']:.3f} |"
+        )
+    return "\n".join(lines)
+
+
 BLOCKS: dict[str, Callable[[], str]] = {
     "issue-11-main": main_comparison,
     "issue-11-probes": probes,
     "issue-11-final-policies": final_policies,
+    "issue-11-bin-interpolation": bin_interpolation,
 }
 
 

@@ -1,0 +1,61 @@
+"""The diagnostics under docs/results against hand-computed values (they are scripts, not package modules)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "results"))
+
+from bin_interpolation import growth_step_errors, quadratic_weights
+
+
+def test_quadratic_weights_are_the_lagrange_weights_of_the_nearest_three_coarse_bins():
+    # Bin 2 (a = -0.5) from bins 0, 4, 8 (a = -1, 0, 1): (x)(x - 1) / 2 = 3/8, (x + 1)(x - 1) / -1 = 3/4,
+    # (x + 1)(x) / 2 = -1/8
+    points, weights = quadratic_weights(2, [0, 4, 8])
+    assert points == [0, 4, 8]
+    assert weights == pytest.approx([3 / 8, 3 / 4, -1 / 8])
+    # Bin 1 (a = -0.75) from 0, 2, 4 (a = -1, -0.5, 0): (x + 0.5)(x) / 0.5 = 3/8, (x + 1)(x) / -0.25 = 3/4,
+    # (x + 1)(x + 0.5) / 0.5 = -1/8; bin 7 mirrors it from 4, 6, 8
+    assert quadratic_weights(1, [0, 2, 4, 6, 8]) == ([0, 2, 4], pytest.approx([3 / 8, 3 / 4, -1 / 8]))
+    assert quadratic_weights(7, [0, 2, 4, 6, 8]) == ([4, 6, 8], pytest.approx([-1 / 8, 3 / 4, 3 / 8]))
+    # Bin 3 (x = -0.25) lies midway between bins 2 and 4: the outer one (2) centres its window 0, 2, 4:
+    # (x + 0.5)(x) / 0.5 = -1/8, (x + 1)(x) / -0.25 = 3/4, (x + 1)(x + 0.5) / 0.5 = 3/8; bin 5 mirrors it
+    assert quadratic_weights(3, [0, 2, 4, 6, 8]) == ([0, 2, 4], pytest.approx([-1 / 8, 3 / 4, 3 / 8]))
+    assert quadratic_weights(5, [0, 2, 4, 6, 8]) == ([4, 6, 8], pytest.approx([3 / 8, 3 / 4, -1 / 8]))
+
+
+def test_growth_step_errors_on_a_quadratic_utility():
+    # U(a) = -a^2 on the 9 bin values, in 2 states and 1 dimension: range max - min = 0 - (-1) = 1.
+    # 3 -> 5: bins 2, 6 (a = -+0.5, U = -0.25) interpolated linearly from (-1, 0): -0.5, so the linear bias is
+    # -0.25 (interpolation below the final utility) and the error 0.25; the quadratic one is exact.
+    utilities = np.tile(-(np.linspace(-1.0, 1.0, 9) ** 2), (2, 1, 1))
+    figures = growth_step_errors(utilities, [0, 4, 8])
+    assert figures["utility_range"] == pytest.approx(1.0)
+    assert figures["linear_bias"] == pytest.approx(-0.25)
+    assert figures["linear_error"] == pytest.approx(0.25)
+    assert figures["quadratic_bias"] == pytest.approx(0.0, abs=1e-12)
+    assert figures["quadratic_error"] == pytest.approx(0.0, abs=1e-12)
+    # 5 -> 9: bins 1, 3, 5, 7 (U = -0.5625, -0.0625, ...) from their neighbours: (-1 - 0.25) / 2 = -0.625 and
+    # (-0.25 + 0) / 2 = -0.125, each 0.0625 below
+    figures = growth_step_errors(utilities, [0, 2, 4, 6, 8])
+    assert figures["linear_bias"] == pytest.approx(-0.0625)
+    assert figures["linear_error"] == pytest.approx(0.0625)
+    assert figures["quadratic_error"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_growth_step_errors_sign_says_the_opened_bins_end_below_their_neighbours():
+    # Utilities 0 except bin 8 = 1, bin 2 = -0.4, bin 6 = 0.1 (range 1 - (-0.4) = 1.4): the linear interpolations
+    # of bins 2 and 6 are 0 and 0.5, each 0.4 above the final utility, so the bias is +0.4 / 1.4
+    utilities = np.zeros((1, 1, 9))
+    utilities[..., 8] = 1.0
+    utilities[..., 2] = -0.4
+    utilities[..., 6] = 0.1
+    figures = growth_step_errors(utilities, [0, 4, 8])
+    assert figures["utility_range"] == pytest.approx(1.4)
+    assert figures["linear_bias"] == pytest.approx(0.4 / 1.4)
+    assert figures["linear_error"] == pytest.approx(0.4 / 1.4)
