@@ -25,13 +25,14 @@ range (max - min over the 9 bins) of the same states so that tasks compare. Rows
 from __future__ import annotations
 
 import argparse
-import csv
 import itertools
 import sys
 from pathlib import Path
 
 import numpy as np
-from final_policies import RESULTS, _read, _rounded, run_spec
+from final_policies import RESULTS, _read, _write, finished_runs
+
+from sb3_gqn.benchmark import RunSpec
 
 OUT = RESULTS / "bin_interpolation.csv"
 STEPS, RANDOM_SHARE, FIRST_SEED = 5_000, 0.3, 30_000
@@ -90,7 +91,7 @@ def growth_step_errors(utilities: np.ndarray, coarse: list[int]) -> dict[str, fl
     return figures
 
 
-def probe(run_dir: Path) -> list[dict[str, float | str]]:
+def probe(run_dir: Path, spec: RunSpec) -> list[dict[str, float | str]]:
     import torch as th
 
     from sb3_gqn import GQN
@@ -99,7 +100,6 @@ def probe(run_dir: Path) -> list[dict[str, float | str]]:
 
     th.set_num_threads(1)
     register()
-    spec = run_spec(run_dir)
     env = make_eval_env(spec)
     model = GQN.load(run_dir / "model.zip", device="cpu")
     if model.policy.max_bins != MAX_BINS or model.active_bins != MAX_BINS:
@@ -137,28 +137,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
     args = parser.parse_args(argv)
-    tables = (
-        [RESULTS / name for name in args.tables] if args.tables else sorted(p.parent for p in RESULTS.glob("*/results.csv"))
-    )
     rows = {(row["table"], row["algo"], row["env"], row["seed"], row["growth_step"]): row for row in _read(OUT)}
-    for table in tables:
-        for run_dir in sorted((table / "runs").glob("*")):
-            if not (run_dir / "model.zip").is_file() or not (run_dir / "done.json").is_file():
-                continue
-            if run_spec(run_dir).algo.split("+")[0] not in args.algos:
-                continue
-            for row in probe(run_dir):
-                rows[tuple(str(row[key]) for key in COLUMNS[:5])] = row
-                print(
-                    f"{row['table']} {row['algo']} seed {row['seed']} {row['growth_step']}: linear bias "
-                    f"{float(row['linear_bias']):+.3f}, error {float(row['linear_error']):.3f} | quadratic "
-                    f"{float(row['quadratic_bias']):+.3f}, {float(row['quadratic_error']):.3f}"
-                )
-    with open(OUT, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
-        writer.writeheader()
-        for key in sorted(rows):
-            writer.writerow({column: _rounded(rows[key][column]) for column in COLUMNS})
+    for run_dir, spec in finished_runs(args.tables, args.algos):
+        for row in probe(run_dir, spec):
+            rows[tuple(str(row[key]) for key in COLUMNS[:5])] = row
+            print(
+                f"{row['table']} {row['algo']} seed {row['seed']} {row['growth_step']}: linear bias "
+                f"{float(row['linear_bias']):+.3f}, error {float(row['linear_error']):.3f} | quadratic "
+                f"{float(row['quadratic_bias']):+.3f}, {float(row['quadratic_error']):.3f}"
+            )
+    _write(OUT, rows, COLUMNS)
     print(f"{OUT}: {len(rows)} rows")
     return 0
 

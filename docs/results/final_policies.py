@@ -97,29 +97,39 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9", "sac"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
     args = parser.parse_args(argv)
+    rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
+    for run_dir, spec in finished_runs(args.tables, args.algos):
+        row = probe(run_dir, spec)
+        rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
+        sm, extremes = float(row["smoothness"]), float(row["extreme_share"])
+        print(f"{row['table']} {row['algo']} seed {row['seed']}: SM {sm:.4f}, extremes {extremes:.2f}")
+    _write(OUT, rows, COLUMNS)
+    print(f"{OUT}: {len(rows)} runs")
+    return 0
+
+
+def finished_runs(table_names: list[str] | None, algos: list[str]) -> list[tuple[Path, RunSpec]]:
+    """The runs (folder and spec) of the named result folders (default: every ``docs/results/*/results.csv``)
+    that finished and kept their ``model.zip``, for the listed algorithms (``gqn-adaptive`` covers its
+    ``+...`` variants)."""
     every_table = sorted(path.parent for path in RESULTS.glob("*/results.csv"))
-    tables = [RESULTS / name for name in args.tables] if args.tables else every_table
+    tables = [RESULTS / name for name in table_names] if table_names else every_table
     runs = [
         (run_dir, run_spec(run_dir))
         for table in tables
         for run_dir in sorted((table / "runs").glob("*"))
         if (run_dir / "model.zip").is_file() and (run_dir / "done.json").is_file()
     ]
-    rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
-    for run_dir, spec in runs:
-        if spec.algo.split("+")[0] not in args.algos:
-            continue
-        row = probe(run_dir, spec)
-        rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
-        sm, extremes = float(row["smoothness"]), float(row["extreme_share"])
-        print(f"{row['table']} {row['algo']} seed {row['seed']}: SM {sm:.4f}, extremes {extremes:.2f}")
-    with open(OUT, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+    return [(run_dir, spec) for run_dir, spec in runs if spec.algo.split("+")[0] in algos]
+
+
+def _write(path: Path, rows: dict[tuple[str, ...], dict[str, float | str]], columns: list[str]) -> None:
+    """``rows`` in key order, floats rounded, as ``path``'s CSV."""
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         for key in sorted(rows):
-            writer.writerow({column: _rounded(rows[key][column]) for column in COLUMNS})
-    print(f"{OUT}: {len(rows)} runs")
-    return 0
+            writer.writerow({column: _rounded(rows[key][column]) for column in columns})
 
 
 def _read(path: Path) -> list[dict[str, str]]:
