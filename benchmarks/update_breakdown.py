@@ -20,12 +20,12 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import time
 from collections.abc import Callable
 
 os.environ.setdefault("MUJOCO_GL", "disable")
 
 import torch as th
+from throughput import CARTPOLE, forward_flops, matmul_peak, seconds_per_call
 from torch import nn
 
 from sb3_gqn import GQN
@@ -33,21 +33,9 @@ from sb3_gqn.envs import make_env
 from sb3_gqn.gqn import clip_grad_norm
 from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
 
-CARTPOLE = "dm_control/cartpole-swingup-v0"
 
-
-def milliseconds_per_call(function: Callable[[], object], calls: int, warmup: int = 20) -> float:
-    for _ in range(warmup):
-        function()
-    started = time.perf_counter()
-    for _ in range(calls):
-        function()
-    return (time.perf_counter() - started) / calls * 1e3
-
-
-def matmul_peak(size: int = 512) -> float:
-    left, right = th.randn(size, size), th.randn(size, size)
-    return max(2 * size**3 / (milliseconds_per_call(lambda: left @ right, 50) / 1e3) for _ in range(3))
+def milliseconds_per_call(function: Callable[[], object], calls: int) -> float:
+    return seconds_per_call(function, calls, warmup=20) * 1e3
 
 
 def main() -> None:
@@ -63,7 +51,7 @@ def main() -> None:
     online = [layer for layer in model.q_net.modules() if isinstance(layer, nn.Linear)]
     target = [layer for layer in model.q_net_target.modules() if isinstance(layer, nn.Linear)]
     mask, optimizer = model.policy.active_bins_mask, model.policy.optimizer
-    floor_flops = 5 * sum(2 * model.batch_size * layer.in_features * layer.out_features for layer in online)
+    floor_flops = 5 * forward_flops(model.q_net, model.batch_size)
 
     def forward(hidden: th.Tensor, layers: list[nn.Linear]) -> th.Tensor:
         for index, layer in enumerate(layers):
