@@ -14,10 +14,9 @@ Without ``PROBE_K`` in the environment it does nothing. Runs (from the repositor
         --penalties 0.1 --seeds 0 1 --steps 100000 --eval-freq 10000 --eval-episodes 3 --out /tmp/probe/walker
 
 The committed ``<task>/results.csv`` files are those runs' tables at ``PROBE_RATE=0.1`` (walker, finger with the
-same algo, cartpole with ``gqn-adaptive``; seeds 0 and 1) and ``walker_rate0.02/results.csv``,
-``cartpole_rate0.02/results.csv`` walker's and cartpole's at ``PROBE_RATE=0.02`` (the runner's algo names, which
-here mean "with this probe"); the README (issue 11's section) and the closing note compare them with the shipped
-runs of the same seeds.
+same algo, cartpole with ``gqn-adaptive``; seeds 0 and 1) and ``<task>_rate0.02/results.csv`` walker's, cartpole's
+and finger's at ``PROBE_RATE=0.02`` (the runner's algo names, which here mean "with this probe"); the README
+(issue 11's section) and the closing note compare them with the shipped runs of the same seeds.
 """
 
 import os
