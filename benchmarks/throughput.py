@@ -2,6 +2,7 @@
 
     python benchmarks/throughput.py                  # ~4 minutes on 2 cores
     python benchmarks/throughput.py --rounds 3       # quicker, noisier
+    python benchmarks/throughput.py --device cuda    # the same on a GPU (peak, updates, acting, training)
 
 1. The CPU's matmul peak (GFLOP/s of a 512x512x512 float32 matmul with torch's threads).
 2. Gradient steps (MLP 512x512, batch 256, prioritized 3-step replay, train(1) as the main job calls it) on
@@ -14,7 +15,9 @@
 4. The exported policy (sb3_gqn.export) at batch 1: TorchScript and ONNX Runtime, next to predict.
 5. Env steps/s while training: the main job's configuration (GQN, 1 update per 2 env steps, cartpole-swingup,
    c = 0.1) against SB3's SAC with its defaults on the same env, and GQN against DQN on CartPole.
-Numbers are only comparable within one run.
+Numbers are only comparable within one run. With ``--device cuda`` the networks, the matmul peak and the
+bare forward live on the GPU and every timing waits for the device (``torch.cuda.synchronize``); the exported
+policies are CPU runtimes and are timed on the CPU in both cases.
 """
 
 from __future__ import annotations
@@ -44,19 +47,27 @@ CARTPOLE = "dm_control/cartpole-swingup-v0"
 HUMANOID = "dm_control/humanoid-walk-v0"
 
 
-def seconds_per_call(function: Callable[[], object], calls: int, warmup: int = 10) -> float:
+def synchronize(device: th.device | str = "cpu") -> None:
+    """Wait for the device's queued work (a no-op on the CPU, where every call is synchronous)."""
+    if th.device(device).type == "cuda":
+        th.cuda.synchronize(device)
+
+
+def seconds_per_call(function: Callable[[], object], calls: int, warmup: int = 10, device: th.device | str = "cpu") -> float:
     for _ in range(warmup):
         function()
+    synchronize(device)
     started = time.perf_counter()
     for _ in range(calls):
         function()
+    synchronize(device)
     return (time.perf_counter() - started) / calls
 
 
-def matmul_peak(size: int = 512, calls: int = 50) -> float:
-    """FLOP/s of a float32 ``size^3`` matmul (best of 3)."""
-    left, right = th.randn(size, size), th.randn(size, size)
-    return max(2 * size**3 / seconds_per_call(lambda: left @ right, calls) for _ in range(3))
+def matmul_peak(size: int = 512, calls: int = 50, device: th.device | str = "cpu") -> float:
+    """FLOP/s of a float32 ``size^3`` matmul on ``device`` (best of 3)."""
+    left, right = th.randn(size, size, device=device), th.randn(size, size, device=device)
+    return max(2 * size**3 / seconds_per_call(lambda: left @ right, calls, device=device) for _ in range(3))
 
 
 def forward_flops(network: nn.Module, batch_size: int) -> int:
@@ -66,14 +77,14 @@ def forward_flops(network: nn.Module, batch_size: int) -> int:
     )
 
 
-def update_cost(env_id: str, rounds: int, updates: int) -> dict[str, float]:
-    model = GQN("MlpPolicy", make_env(env_id, action_penalty=0.1), seed=0)
+def update_cost(env_id: str, rounds: int, updates: int, device: str = "cpu") -> dict[str, float]:
+    model = GQN("MlpPolicy", make_env(env_id, action_penalty=0.1), seed=0, device=device)
     model.learn(model.learning_starts + 500)
     floor_flops = 5 * forward_flops(model.q_net, model.batch_size)
     ratios, update_seconds, peaks = [], [], []
     for _ in range(rounds):
-        peak = matmul_peak()
-        seconds = seconds_per_call(lambda: model.train(gradient_steps=1, batch_size=model.batch_size), updates)
+        peak = matmul_peak(device=device)
+        seconds = seconds_per_call(lambda: model.train(gradient_steps=1, batch_size=model.batch_size), updates, device=device)
         peaks.append(peak)
         update_seconds.append(seconds)
         ratios.append(seconds / (floor_flops / peak))
@@ -103,22 +114,25 @@ def bare_forward_argmax(model: GQN) -> Callable[[th.Tensor], th.Tensor]:
     return act
 
 
-def acting_cost(calls: int) -> dict[str, float]:
+def acting_cost(calls: int, device: str = "cpu") -> dict[str, float]:
+    """Seconds per call at batch 1, each path from a numpy observation to its result on the host."""
     env = make_env(CARTPOLE, action_penalty=0.1)
-    model = GQN("MlpPolicy", env, seed=0)
+    model = GQN("MlpPolicy", env, seed=0, device=device)
     observation = env.reset(seed=0)[0][None]
     observation_tensor = th.as_tensor(observation, dtype=th.float32)
     bare = bare_forward_argmax(model)
 
     def bare_call() -> np.ndarray:
         with th.inference_mode():
-            return bare(observation_tensor).numpy()
+            return bare(observation_tensor.to(model.device)).cpu().numpy()
 
     costs = {
-        "bare": seconds_per_call(bare_call, calls),
-        "act": seconds_per_call(lambda: model.policy.act(observation), calls),
-        "GQN.predict": seconds_per_call(lambda: model.predict(observation, deterministic=True), calls),
-        "SB3 predict": seconds_per_call(lambda: BasePolicy.predict(model.policy, observation, deterministic=True), calls),
+        "bare": seconds_per_call(bare_call, calls, device=device),
+        "act": seconds_per_call(lambda: model.policy.act(observation), calls, device=device),
+        "GQN.predict": seconds_per_call(lambda: model.predict(observation, deterministic=True), calls, device=device),
+        "SB3 predict": seconds_per_call(
+            lambda: BasePolicy.predict(model.policy, observation, deterministic=True), calls, device=device
+        ),
     }
     try:
         from sb3_gqn.export import export_onnx, export_torchscript
@@ -153,21 +167,26 @@ def main() -> None:
     parser.add_argument("--updates", type=int, default=100, help="timed gradient steps per round")
     parser.add_argument("--calls", type=int, default=2000, help="timed acting calls per path")
     parser.add_argument("--steps", type=int, default=3000, help="timed env steps per algorithm")
+    parser.add_argument("--device", default="cpu", help="torch device of the networks: cpu or cuda")
     args = parser.parse_args()
-    print(f"torch {th.__version__}, {th.get_num_threads()} threads\n")
+    device = args.device
+    if th.device(device).type == "cuda" and not th.cuda.is_available():
+        parser.error(f"--device {device}: torch sees no CUDA device on this machine")
+    where = th.cuda.get_device_name(device) if th.device(device).type == "cuda" else "CPU"
+    print(f"torch {th.__version__}, {th.get_num_threads()} threads, device {device} ({where})\n")
 
     print("Gradient step (MLP 512x512, batch 256, prioritized 3-step replay) against its FLOP-bound time")
     print("| env | obs | utilities | matmul peak | FLOP-bound | ms / update | ratio |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
     for env_id in (CARTPOLE, HUMANOID):
-        cost = update_cost(env_id, args.rounds, args.updates)
+        cost = update_cost(env_id, args.rounds, args.updates, device)
         print(
             f"| {env_id.split('/')[-1]} | {cost['obs_dim']} | {cost['utilities']} | {cost['peak_gflops']:.0f} GFLOP/s "
             f"| {cost['floor_ms']:.2f} ms | {cost['update_ms']:.2f} ms | {cost['ratio']:.2f}x |"
         )
 
     print("\nActing at batch 1 (cartpole-swingup, MLP 512x512)")
-    costs = acting_cost(args.calls)
+    costs = acting_cost(args.calls, device)
     print("| path | us / call | vs bare |")
     print("| --- | ---: | ---: |")
     for name, seconds in costs.items():
@@ -176,15 +195,18 @@ def main() -> None:
     print("\nEnv steps/s while training (after the warm-up)")
     speeds = {
         "GQN main job (train_freq 2), cartpole-swingup": training_speed(
-            lambda: GQN("MlpPolicy", make_env(CARTPOLE, action_penalty=0.1), train_freq=2, seed=0), args.steps
+            lambda: GQN("MlpPolicy", make_env(CARTPOLE, action_penalty=0.1), train_freq=2, seed=0, device=device),
+            args.steps,
         ),
         "SAC (SB3 defaults), cartpole-swingup": training_speed(
-            lambda: SAC("MlpPolicy", make_env(CARTPOLE, action_penalty=0.1), seed=0), args.steps // 3
+            lambda: SAC("MlpPolicy", make_env(CARTPOLE, action_penalty=0.1), seed=0, device=device), args.steps // 3
         ),
         "GQN (bins=2), CartPole-v1": training_speed(
-            lambda: GQN("MlpPolicy", "CartPole-v1", bins=2, growth=None, seed=0), args.steps
+            lambda: GQN("MlpPolicy", "CartPole-v1", bins=2, growth=None, seed=0, device=device), args.steps
         ),
-        "DQN (SB3 defaults), CartPole-v1": training_speed(lambda: DQN("MlpPolicy", "CartPole-v1", seed=0), args.steps),
+        "DQN (SB3 defaults), CartPole-v1": training_speed(
+            lambda: DQN("MlpPolicy", "CartPole-v1", seed=0, device=device), args.steps
+        ),
     }
     print("| run | env steps/s |")
     print("| --- | ---: |")
