@@ -15,7 +15,8 @@ Without ``PROBE_K`` in the environment it does nothing. Runs (from the repositor
 
 The committed ``<task>/results.csv`` files are those runs' tables at ``PROBE_RATE=0.1`` (walker, finger with the
 same algo, cartpole with ``gqn-adaptive``; seeds 0 and 1) and ``<task>_rate0.02/results.csv`` walker's, cartpole's
-and finger's at ``PROBE_RATE=0.02`` (the runner's algo names, which here mean "with this probe"); the README
+and finger's at ``PROBE_RATE=0.02`` (walker's with seeds 0-5, the others 0 and 1; the runner's algo names,
+which here mean "with this probe"); the README
 (issue 11's section) and the closing note compare them with the shipped runs of the same seeds.
 """
 
