@@ -37,6 +37,7 @@ from typing import Any
 os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoCo off any GL backend
 
 import gymnasium as gym
+from filelock import FileLock
 from stable_baselines3.common.callbacks import BaseCallback
 
 from sb3_gqn.metrics import rollout_figures
@@ -367,21 +368,25 @@ def collect(specs: list[RunSpec], out: Path) -> Path:
     """Write ``<out>/results.csv``: the suite's finished curves, plus every run an earlier table recorded.
 
     A run finished in ``runs/`` replaces its earlier rows; runs of other invocations are kept, so
-    invocations with different algorithms or seeds accumulate into one table.
+    invocations with different algorithms or seeds accumulate into one table. Invocations that share
+    ``out`` and finish together take turns: the read-modify-write holds an exclusive lock on
+    ``<out>/results.csv.lock``, so neither writes a table that lacks the other's runs.
     """
     table = out / "results.csv"
-    rows_by_run = recorded_rows(table)
-    for spec in specs:
-        curve = out / "runs" / spec.name / "curve.csv"
-        if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
-            with open(curve, newline="") as rows:
-                rows_by_run[spec.key] = list(csv.DictReader(rows))
-    with open(table.with_suffix(".csv.tmp"), "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
-        writer.writeheader()
-        for key in sorted(rows_by_run, key=lambda key: (key[1], key[2], key[0], key[3])):
-            writer.writerows({column: row.get(column, "") for column in COLUMNS} for row in rows_by_run[key])
-    os.replace(table.with_suffix(".csv.tmp"), table)
+    with FileLock(out / "results.csv.lock"):
+        rows_by_run = recorded_rows(table)
+        for spec in specs:
+            curve = out / "runs" / spec.name / "curve.csv"
+            if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
+                with open(curve, newline="") as rows:
+                    rows_by_run[spec.key] = list(csv.DictReader(rows))
+        scratch = table.with_suffix(f".csv.{os.getpid()}.tmp")
+        with open(scratch, "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
+            writer.writeheader()
+            for key in sorted(rows_by_run, key=lambda key: (key[1], key[2], key[0], key[3])):
+                writer.writerows({column: row.get(column, "") for column in COLUMNS} for row in rows_by_run[key])
+        os.replace(scratch, table)
     return table
 
 

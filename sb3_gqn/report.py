@@ -4,6 +4,7 @@
     python -m sb3_gqn.report docs/results/*/results.csv --plots docs/results/all   # plus the cross-task IQM plot
     python -m sb3_gqn.report docs/results/*/results.csv --algos gqn-adaptive decqn-9 decqn-2   # only these
     python -m sb3_gqn.report ... --shipped dm_control/finger-spin-v0=+layernorm+1update   # finger's entries
+    python -m sb3_gqn.report ... --compare gqn-adaptive:decqn-9 gqn-adaptive:sac   # how sure each comparison is
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
@@ -11,7 +12,10 @@ Prints, from the tables alone (no model files needed, so committed tables are en
 * per algorithm and task, the mean final return and SM over seeds;
 * the growth check of every GQN run: for each growth event, the last evaluation before it and the first
   after it, and whether the return held (held_after_growth);
-* rliable's IQM of min-max normalized final returns across the tasks, with 95 % bootstrap intervals.
+* rliable's IQM of min-max normalized final returns across the tasks, with 95 % bootstrap intervals;
+* with --compare A:B, how far the seeds resolve each comparison of A with B (sb3_gqn.significance): the IQM
+  difference and P(A > B) across tasks, and per task the difference of mean final return and of mean SM, each
+  with a 95 % bootstrap interval, and the seeds per agent a test would need to resolve the return difference.
 """
 
 from __future__ import annotations
@@ -26,6 +30,13 @@ import numpy as np
 import pandas as pd
 
 from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores, run_growth_events
+from sb3_gqn.significance import (
+    difference_interval,
+    iqm_difference,
+    mean_difference,
+    probability_of_improvement,
+    seeds_to_resolve,
+)
 
 
 def held_after_growth(before: float, after: float) -> bool:
@@ -133,9 +144,79 @@ class Section:
     body: str
 
 
-def report_sections(table: pd.DataFrame, reps: int = 2000) -> dict[str, Section]:
-    """The report's tables by key: ``final``, ``means``, then ``growth`` (GQN runs only) and ``iqm`` (two tasks
-    or more) where the table has them."""
+def _signed(value: float, interval: tuple[float, float], digits: int) -> str:
+    """``+0.12 [-0.05, +0.30]``: an estimate with its interval (``-`` for an interval one run cannot give)."""
+    if np.isnan(interval[0]):
+        return f"{value:+.{digits}f}"
+    return f"{value:+.{digits}f} [{interval[0]:+.{digits}f}, {interval[1]:+.{digits}f}]"
+
+
+def comparison_sections(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> dict[str, Section]:
+    """How far the seeds resolve each comparison of ``pairs`` (``(A, B)``: A compared with B).
+
+    ``comparison_tasks`` (pairs with runs of both on two tasks or more): IQM(A) - IQM(B) and P(A > B) on the min-max
+    normalized final returns of the IQM table, with 95 % bootstrap intervals. ``comparison_per_task``: per task
+    where both ran, mean final return of A minus B and mean SM of A minus B with 95 % bootstrap intervals, and the
+    seeds per agent that would resolve the return difference (sb3_gqn.significance.seeds_to_resolve).
+    """
+    sections: dict[str, Section] = {}
+    scores, tasks = normalized_final_scores(table)
+    across = []
+    for first, second in pairs:
+        if first in scores and second in scores and len(tasks) > 1:
+            iqm, iqm_interval = difference_interval(iqm_difference, scores[first], scores[second], reps)
+            improvement, improvement_interval = difference_interval(
+                probability_of_improvement, scores[first], scores[second], reps
+            )
+            across.append(
+                {
+                    "A vs B": f"{first} vs {second}",
+                    "runs per task": f"{scores[first].shape[0]} / {scores[second].shape[0]}",
+                    "IQM(A) - IQM(B) (95 % CI)": _signed(iqm, iqm_interval, 2),
+                    "P(A > B) (95 % CI)": f"{improvement:.2f}"
+                    if np.isnan(improvement_interval[0])
+                    else f"{improvement:.2f} [{improvement_interval[0]:.2f}, {improvement_interval[1]:.2f}]",
+                }
+            )
+    if across:
+        sections["comparison_tasks"] = Section(
+            f"Comparisons across {len(tasks)} tasks (normalized final return, the IQM table's runs; P(A > B) = 0.5 is a tie)",
+            _markdown(pd.DataFrame(across)),
+        )
+    final = final_rows(table)
+    per_task = []
+    for (env, penalty), runs in final.groupby(["env", "penalty"]):
+        for first, second in pairs:
+            runs_first, runs_second = runs[runs["algo"] == first], runs[runs["algo"] == second]
+            if runs_first.empty or runs_second.empty:
+                continue
+            returns = (runs_first["return"].to_numpy(), runs_second["return"].to_numpy())
+            smoothness = (runs_first["smoothness"].to_numpy(), runs_second["smoothness"].to_numpy())
+            difference, interval = difference_interval(mean_difference, *returns, reps)
+            sm_difference, sm_interval = difference_interval(mean_difference, *smoothness, reps)
+            enough = min(len(returns[0]), len(returns[1])) >= 2
+            per_task.append(
+                {
+                    "env": f"{str(env).replace('dm_control/', '')} c={penalty:g}",
+                    "A vs B": f"{first} vs {second}",
+                    "seeds": f"{len(returns[0])} / {len(returns[1])}",
+                    "mean return A - B (95 % CI)": _signed(difference, interval, 0),
+                    "seeds to resolve it": "-" if not enough else f"{seeds_to_resolve(*returns):.0f}",
+                    "mean SM A - B (95 % CI)": _signed(sm_difference, sm_interval, 4),
+                }
+            )
+    if per_task:
+        sections["comparison_per_task"] = Section(
+            "Comparisons per task (final return and SM, A minus B; seeds per agent for a test at 5 % to detect the "
+            "return difference with 80 % power)",
+            _markdown(pd.DataFrame(per_task)),
+        )
+    return sections
+
+
+def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None) -> dict[str, Section]:
+    """The report's tables by key: ``final``, ``means``, then ``growth`` (GQN runs only), ``iqm`` (two tasks
+    or more) and, for ``pairs``, ``comparison_tasks`` and ``comparison_per_task`` where the table has them."""
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
     sections: dict[str, Section] = {}
     columns = {
@@ -196,12 +277,15 @@ def report_sections(table: pd.DataFrame, reps: int = 2000) -> dict[str, Section]
         names = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks)
         heading = f"IQM of min-max normalized final return across {len(tasks)} tasks ({names})"
         sections["iqm"] = Section(heading, _markdown(pd.DataFrame(rows)))
+    if pairs:
+        sections.update(comparison_sections(table, pairs, reps))
     return sections
 
 
-def report(table: pd.DataFrame, reps: int = 2000) -> str:
+def report(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None) -> str:
     """All tables as one markdown text."""
-    return "\n\n".join(f"### {section.heading}\n\n{section.body}" for section in report_sections(table, reps).values()) + "\n"
+    sections = report_sections(table, reps, pairs).values()
+    return "\n\n".join(f"### {section.heading}\n\n{section.body}" for section in sections) + "\n"
 
 
 def plot_table(table: pd.DataFrame, out: Path) -> list[Path]:
@@ -229,7 +313,18 @@ def main(argv: list[str] | None = None) -> int:
         help="on ENV the shipped entries are the runner's SUFFIX variants: report their runs under the plain "
         "names, in place of the runs of the earlier entry (e.g. dm_control/walker-walk-v0=+layernorm+1update)",
     )
+    parser.add_argument(
+        "--compare",
+        nargs="+",
+        default=[],
+        metavar="A:B",
+        help="also say how far the seeds resolve each comparison of algorithm A with B: IQM difference and P(A > B) "
+        "across tasks, per task the differences of mean return and SM, with 95 %% bootstrap intervals",
+    )
     args = parser.parse_args(argv)
+    pairs = [tuple(item.split(":", 1)) for item in args.compare]
+    if any(len(pair) != 2 or not all(pair) for pair in pairs):
+        parser.error(f"--compare takes A:B pairs of algorithm names, got {args.compare}")
     shipped = [item.split("=", 1) for item in args.shipped]
     if any(len(item) != 2 or not all(item) for item in shipped):
         parser.error(f"--shipped takes ENV=SUFFIX pairs, got {args.shipped}")
@@ -242,7 +337,11 @@ def main(argv: list[str] | None = None) -> int:
         table = as_shipped(table, env, suffix)
     if args.algos:
         table = table[table["algo"].isin(args.algos)]
-    print(report(table, args.reps))
+    unknown = sorted({name for pair in pairs for name in pair} - set(table["algo"]))
+    if unknown:
+        print(f"sb3_gqn.report: error: no runs of {', '.join(unknown)} to compare", file=sys.stderr)
+        return 2
+    print(report(table, args.reps, pairs))
     if args.plots is not None:
         for path in plot_table(table, args.plots):
             print(f"plot: {path}")

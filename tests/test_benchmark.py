@@ -4,11 +4,24 @@ from __future__ import annotations
 
 import csv
 import importlib
+import json
 import re
+import threading
+import time
 
 import pytest
 
-from sb3_gqn.benchmark import COLUMNS, RunSpec, learning_starts, main, parse_args, penalized_wrappers, untrained_runs
+import sb3_gqn.benchmark as benchmark
+from sb3_gqn.benchmark import (
+    COLUMNS,
+    RunSpec,
+    collect,
+    learning_starts,
+    main,
+    parse_args,
+    penalized_wrappers,
+    untrained_runs,
+)
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
@@ -118,6 +131,39 @@ def test_a_committed_table_alone_resumes_and_accumulates(tmp_path, capsys):
     assert sorted({row["algo"] for row in rows}) == ["decqn-2", "gqn-adaptive"]
     assert [line for line in table.read_text().splitlines()[1:] if line.startswith("decqn-2")] == decqn_rows
     assert all(row["growth_events"] == "" for row in rows if row["algo"] == "decqn-2")
+
+
+def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp_path, monkeypatch):
+    # Two invocations sharing --out finish together: each reads the table, adds its run and writes it back.
+    # Reading is slowed so the two read-modify-writes overlap unless collect() serializes them; without the
+    # lock the later writer drops the earlier one's run.
+    out = tmp_path / "suite"
+    specs = [RunSpec("decqn-2", "Pendulum-v1", 0.1, seed, 400) for seed in (0, 1)]
+    for spec in specs:
+        run_dir = out / "runs" / spec.name
+        run_dir.mkdir(parents=True)
+        row = {"algo": spec.algo, "env": spec.env, "penalty": spec.penalty, "seed": spec.seed, "step": 400, "return": -1.0}
+        with open(run_dir / "curve.csv", "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(row))
+            writer.writeheader()
+            writer.writerow(row)
+        (run_dir / "done.json").write_text(json.dumps({}))
+    read_table = benchmark.recorded_rows
+
+    def slow_read(table):
+        rows = read_table(table)
+        time.sleep(0.3)
+        return rows
+
+    monkeypatch.setattr(benchmark, "recorded_rows", slow_read)
+    threads = [threading.Thread(target=collect, args=([spec], out)) for spec in specs]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    with open(out / "results.csv", newline="") as handle:
+        assert sorted(int(row["seed"]) for row in csv.DictReader(handle)) == [0, 1]
+    assert not list(out.glob("*.tmp"))
 
 
 def test_ablation_variants_differ_from_the_defaults_in_one_change_each():

@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from sb3_gqn.plots import aggregate, learning_curves, smoothness_radar
-from sb3_gqn.report import as_shipped, load, report_sections
+from sb3_gqn.report import as_shipped, comparison_sections, load, report_sections
 
 RESULTS = Path("docs/results")
 README = Path("README.md")
@@ -32,6 +32,14 @@ PROBES = [
     "gqn-adaptive+layernorm",
     "decqn-9+layernorm",
 ]
+#: the bar's comparisons (issue 11) and gqn-linear's against decqn-9, across tasks and per task; SAC's per task
+MAIN_PAIRS = [
+    ("gqn-adaptive", "decqn-9"),
+    ("gqn-adaptive", "decqn-2"),
+    ("gqn-linear", "decqn-9"),
+    ("gqn-adaptive", "gqn-linear"),
+]
+BASELINE_PAIRS = [("gqn-adaptive", "sac"), ("gqn-linear", "sac"), ("decqn-9", "sac")]
 MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
 
 
@@ -50,6 +58,9 @@ def main_comparison() -> str:
     smoothness_radar(with_baselines, RESULTS / "main")
     aggregate(main, RESULTS / "main")
     sections = report_sections(main, reps=2000)
+    # across tasks on the IQM table's runs (its normalization); per task on the raw returns, SAC included
+    across = comparison_sections(main, MAIN_PAIRS, reps=2000)["comparison_tasks"]
+    per_task = comparison_sections(with_baselines, [*MAIN_PAIRS, *BASELINE_PAIRS], reps=2000)["comparison_per_task"]
     return "\n\n".join(
         [
             "**Final greedy evaluation, gqn-adaptive vs gqn-linear vs decqn-9 vs decqn-2 (shipped entries)**",
@@ -60,6 +71,10 @@ def main_comparison() -> str:
             sections["growth"].body,
             f"**{sections['iqm'].heading}**",
             sections["iqm"].body,
+            f"**{across.heading}**",
+            across.body,
+            f"**{per_task.heading}**",
+            per_task.body,
             "\n".join(
                 f"![{path.stem.replace('_', ' ')}](docs/results/main/{path.name})"
                 for path in sorted((RESULTS / "main").glob("learning_curves_*.png"))

@@ -1,0 +1,132 @@
+"""How far comparisons are resolved (sb3_gqn.significance) and the report's comparison tables, against hand values."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from sb3_gqn.report import main, report_sections
+from sb3_gqn.significance import (
+    difference_interval,
+    iqm_difference,
+    mean_difference,
+    probability_of_improvement,
+    seeds_to_resolve,
+)
+
+
+def test_probability_of_improvement_counts_pairs_and_half_ties_per_task_then_averages():
+    # (3 > 2) twice, (2 = 2) twice counting one half, (1 < 2) twice: (2 + 1) / 6
+    assert probability_of_improvement(np.array([[1.0], [2.0], [3.0]]), np.array([[2.0], [2.0]])) == pytest.approx(0.5)
+    # task 1: X wins all 4 pairs; task 2: X = [2, 5] vs Y = [2, 3]: tie, loss, win, win = 2.5 / 4; mean 0.8125
+    scores_x = np.array([[3.0, 2.0], [4.0, 5.0]])
+    scores_y = np.array([[1.0, 2.0], [2.0, 3.0]])
+    assert probability_of_improvement(scores_x, scores_y) == pytest.approx(0.8125)
+    assert probability_of_improvement(scores_y, scores_x) == pytest.approx(1 - 0.8125)
+
+
+def test_iqm_difference_and_mean_difference_hand_values():
+    # IQM of 1..8 drops the lowest and highest quarter: mean(3, 4, 5, 6) = 4.5; IQM of 1..4 = mean(2, 3) = 2.5
+    eight, four = np.arange(1.0, 9.0).reshape(-1, 1), np.arange(1.0, 5.0).reshape(-1, 1)
+    assert iqm_difference(eight, four) == pytest.approx(2.0)
+    assert iqm_difference(eight, eight + 100.0) == pytest.approx(-100.0)  # an outlier-free shift survives whole
+    assert mean_difference(np.array([10.0, 20.0, 30.0]), np.array([1.0, 3.0])) == pytest.approx(18.0)
+
+
+def test_difference_interval_brackets_the_estimate_within_what_resampling_can_reach():
+    same_x, same_y = np.full(4, 5.0), np.full(3, 2.0)
+    value, (low, high) = difference_interval(mean_difference, same_x, same_y, reps=200)
+    assert (value, low, high) == (3.0, 3.0, 3.0)  # nothing varies, nothing to be unsure about
+    values_x, values_y = np.array([0.0, 10.0, 20.0, 30.0]), np.array([5.0, 6.0, 40.0])
+    value, (low, high) = difference_interval(mean_difference, values_x, values_y, reps=500)
+    assert value == pytest.approx(15.0 - 17.0)
+    # a resampled mean lies between the sample's extremes, so the difference lies in [0 - 40, 30 - 5]
+    assert -40.0 <= low < value < high <= 25.0
+    assert difference_interval(mean_difference, values_x, values_y, reps=500) == (value, (low, high))  # seeded
+    assert difference_interval(mean_difference, values_x, values_y, reps=500, seed=1) != (value, (low, high))
+    np.random.seed(7)
+    expected = np.random.random()
+    np.random.seed(7)
+    difference_interval(mean_difference, values_x, values_y, reps=50)
+    assert np.random.random() == expected  # the caller's global NumPy stream is left where it was
+    one_run, (low, high) = difference_interval(mean_difference, np.array([7.0]), values_y)
+    assert one_run == pytest.approx(7.0 - 17.0) and math.isnan(low) and math.isnan(high)
+    with pytest.raises(ValueError, match="same tasks"):
+        difference_interval(iqm_difference, np.zeros((3, 2)), np.zeros((3, 3)))
+
+
+def test_seeds_to_resolve_hand_values():
+    # s^2 = (2 + 2) / 2, d = -1: 2 * (1.959964 + 0.841621)^2 * 2 / 1 = 31.39 -> 32 seeds per agent
+    assert seeds_to_resolve(np.array([0.0, 2.0]), np.array([1.0, 3.0])) == 32
+    # ten times the difference at the same spread needs a hundredth: 0.31 -> at least 2
+    assert seeds_to_resolve(np.array([0.0, 2.0]), np.array([10.0, 12.0])) == 2
+    # d = 2, s^2 = (8 + 2) / 2 = 5: 2 * 7.8489 * 5 / 4 = 19.6 -> 20; a stricter test needs more
+    assert seeds_to_resolve(np.array([0.0, 4.0]), np.array([-1.0, 1.0])) == 20
+    assert seeds_to_resolve(np.array([0.0, 4.0]), np.array([-1.0, 1.0]), alpha=0.01) > 20
+    assert seeds_to_resolve(np.array([1.0, 3.0]), np.array([2.0, 2.0])) == math.inf
+    with pytest.raises(ValueError, match="two runs"):
+        seeds_to_resolve(np.array([1.0]), np.array([2.0, 3.0]))
+
+
+def _final(algo, env, seed, value, smoothness):
+    return {
+        "algo": algo,
+        "env": env,
+        "penalty": 0.1,
+        "seed": seed,
+        "step": 1000,
+        "return": value,
+        "task_return": value,
+        "action_penalty": 0.0,
+        "action_change": 0.1,
+        "smoothness": smoothness,
+        "active_bins": 9,
+        "wall_time": 10.0,
+        "growth_events": "",
+    }
+
+
+def _two_task_table():
+    rows = []
+    for seed, (a_one, b_one, a_two, b_two) in enumerate([(10, 0, 300, 100), (20, 0, 100, 300), (30, 0, 200, 200)]):
+        rows += [
+            _final("a", "one", seed, a_one, 0.02),
+            _final("b", "one", seed, b_one, 0.01),
+            _final("a", "two", seed, a_two, 0.01),
+            _final("b", "two", seed, b_two, 0.01),
+        ]
+    rows.append(_final("c", "one", 0, 5.0, 0.01))  # one run, on one task only
+    return pd.DataFrame(rows)
+
+
+def test_report_states_each_comparison_with_its_interval():
+    sections = report_sections(_two_task_table(), reps=200, pairs=[("a", "b"), ("a", "c")])
+    across = sections["comparison_tasks"].body
+    # normalized over all runs per task: task one a = [1/3, 2/3, 1] vs b = 0 (c's 5 is 1/6); task two a and b are
+    # the same three values. P(a > b): task one 1, task two (3 ties / 2 + 3 wins of 9 pairs) = 0.5 -> 0.75
+    assert "| a vs b | 3 / 3 |" in across and "| 0.75 [" in across
+    assert "a vs c" not in across  # c did not run on every task
+    per_task = sections["comparison_per_task"].body.splitlines()
+    row_one = next(line for line in per_task if line.startswith("| one c=0.1 | a vs b |"))
+    # task one: mean 20 - 0; SM 0.02 - 0.01; 2 * 7.8489 * (100 + 0) / 2 / 400 = 1.96 -> 2 seeds
+    assert "| 3 / 3 | +20 [" in row_one and "| 2 | +0.0100 [+0.0100, +0.0100] |" in row_one
+    row_two = next(line for line in per_task if line.startswith("| two c=0.1 | a vs b |"))
+    assert "| +0 [" in row_two and "| inf |" in row_two  # equal means: no number of seeds resolves it
+    row_c = next(line for line in per_task if "a vs c" in line)
+    assert "| 3 / 1 | +15 | - |" in row_c  # one run of c: no interval, no seed count
+    assert "comparison_tasks" not in report_sections(_two_task_table(), reps=50)
+
+
+def test_compare_option_rejects_bad_pairs_and_unknown_algorithms(tmp_path, capsys):
+    table = tmp_path / "results.csv"
+    _two_task_table().to_csv(table, index=False)
+    with pytest.raises(SystemExit):
+        main([str(table), "--compare", "a-b"])
+    assert "A:B pairs" in capsys.readouterr().err
+    assert main([str(table), "--compare", "a:sac"]) == 2
+    assert "no runs of sac" in capsys.readouterr().err
+    assert main([str(table), "--compare", "a:b", "--reps", "100"]) == 0
+    assert "Comparisons per task" in capsys.readouterr().out
