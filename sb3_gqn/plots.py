@@ -28,6 +28,9 @@ RADAR_CAPTION = (
     "between steps, SM: smoothness (spectral, higher frequencies weigh more): smaller is smoother. "
     "Each axis is the ratio to the reference agent."
 )
+#: radar ratios above this are drawn at it, with their value written beside the point, so that one agent's
+#: outlier (e.g. decqn-2's action penalty, ~10x the reference's) does not squeeze every other line into the centre
+RADAR_CLIP = 4.0
 RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 RADAR_DASHES = ("-", "--", "-.", ":")
 # Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
@@ -228,6 +231,16 @@ def _reference(final: pd.DataFrame) -> tuple[str, float] | None:
     return None
 
 
+def clipped_radii(ratios: np.ndarray, clip: float = RADAR_CLIP) -> tuple[np.ndarray, np.ndarray]:
+    """The radar's radii for ``ratios``: each ratio, or ``clip`` where it is larger, and which ones were clipped.
+
+    ``[0.5, 4.0, 10.2]`` with ``clip=4`` is drawn at ``[0.5, 4.0, 4.0]``, the last marked clipped.
+    """
+    ratios = np.asarray(ratios, dtype=np.float64)
+    clipped = ratios > clip
+    return np.where(clipped, clip, ratios), clipped
+
+
 def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
     """Figure 4 per env: R, P, |a|, |Δa|, SM of the final policies relative to the reference agent."""
     paths = []
@@ -239,9 +252,11 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         base = means.loc[reference].replace(0.0, np.nan)
         angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
         figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
+        any_clipped = False
         for index, ((algo, penalty), values) in enumerate(means.iterrows()):
             relative = (values / base).abs().fillna(0.0).to_numpy()
-            closed = np.append(relative, relative[0])
+            radii, clipped = clipped_radii(relative)
+            closed = np.append(radii, radii[0])
             # markers and dash patterns tell apart lines that coincide (e.g. two agents that are both bang-bang)
             axis.plot(
                 np.append(angles, angles[0]),
@@ -252,10 +267,26 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
                 markersize=6,
                 alpha=0.85,
             )
+            color = axis.get_lines()[-1].get_color()
+            for angle, ratio in zip(angles[clipped], relative[clipped]):
+                axis.annotate(
+                    f"{ratio:.1f}x",
+                    (angle, RADAR_CLIP),
+                    xytext=(4, 4 + 9 * (index % 3)),
+                    color=color,
+                    textcoords="offset points",
+                    fontsize=7,
+                )
+            any_clipped = any_clipped or bool(clipped.any())
+        if any_clipped:
+            axis.set_ylim(0, RADAR_CLIP * 1.05)
         axis.set_xticks(angles, list(RADAR_METRICS.values()))
         axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g} (= 1)", fontsize=9)
         axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.2))
-        figure.text(0.5, 0.01, textwrap.fill(RADAR_CAPTION, 105), ha="center", va="bottom", fontsize=7)
+        caption = RADAR_CAPTION + (
+            f" Ratios above {RADAR_CLIP:g} are drawn at {RADAR_CLIP:g}, their value beside them." if any_clipped else ""
+        )
+        figure.text(0.5, 0.01, textwrap.fill(caption, 105), ha="center", va="bottom", fontsize=7)
         figure.tight_layout(rect=(0, 0.07, 1, 1))
         path = out / f"smoothness_radar_{_slug(env)}.png"
         figure.savefig(path, dpi=110)

@@ -5,8 +5,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import sb3_gqn.plots as plots
 from sb3_gqn import GQN
-from sb3_gqn.plots import aggregate, degenerate_tasks, normalized_final_scores, q_value_picture, save_q_snapshot
+from sb3_gqn.plots import (
+    RADAR_CLIP,
+    aggregate,
+    clipped_radii,
+    degenerate_tasks,
+    normalized_final_scores,
+    q_value_picture,
+    save_q_snapshot,
+    smoothness_radar,
+)
 
 
 def table(returns: dict[tuple[str, str], float]) -> pd.DataFrame:
@@ -27,6 +37,27 @@ def test_degenerate_normalization_is_detected_and_said_on_the_iqm_plot(tmp_path)
     np.testing.assert_array_equal(scores["gqn"], [[0.0, 0.0]])
     np.testing.assert_array_equal(scores["sac"], [[0.0, 1.0]])
     assert aggregate(results, tmp_path, reps=50).stat().st_size > 5_000
+
+
+def test_radar_clips_outlying_ratios_and_writes_their_value(tmp_path, monkeypatch):
+    radii, clipped = clipped_radii(np.array([0.5, 4.0, 10.2]), clip=4.0)
+    np.testing.assert_array_equal(radii, [0.5, 4.0, 4.0])
+    np.testing.assert_array_equal(clipped, [False, False, True])
+    final = {"task_return": 800.0, "action_penalty": 100.0, "action_magnitude": 0.3, "action_change": 0.1, "smoothness": 0.01}
+    outlier = {**final, "task_return": 400.0, "action_penalty": 1020.0, "action_magnitude": 1.0}  # P ratio 10.2
+    rows = [
+        {"algo": algo, "env": "A", "penalty": 0.1, "seed": 0, "step": 100, **values}
+        for algo, values in (("gqn-adaptive", final), ("decqn-2", outlier))
+    ]
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)  # keep the figure to look at it
+    [path] = smoothness_radar(pd.DataFrame(rows), tmp_path)
+    assert path.is_file()
+    [axis] = figures[0].axes
+    assert axis.get_ylim()[1] == RADAR_CLIP * 1.05
+    assert [text.get_text() for text in axis.texts] == ["10.2x"]  # P; |a| is 3.3x, drawn as it is
+    assert max(max(line.get_ydata()) for line in axis.get_lines()) == RADAR_CLIP
+    assert "drawn at 4" in " ".join(text.get_text() for text in figures[0].texts)
 
 
 def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
