@@ -258,7 +258,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
             radii, clipped = clipped_radii(relative)
             closed = np.append(radii, radii[0])
             # markers and dash patterns tell apart lines that coincide (e.g. two agents that are both bang-bang)
-            axis.plot(
+            [line] = axis.plot(
                 np.append(angles, angles[0]),
                 closed,
                 label=f"{algo} c={penalty:g}",
@@ -267,13 +267,12 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
                 markersize=6,
                 alpha=0.85,
             )
-            color = axis.get_lines()[-1].get_color()
             for angle, ratio in zip(angles[clipped], relative[clipped]):
                 axis.annotate(
                     f"{ratio:.1f}x",
                     (angle, RADAR_CLIP),
                     xytext=(4, 4 + 9 * (index % 3)),
-                    color=color,
+                    color=line.get_color(),
                     textcoords="offset points",
                     fontsize=7,
                 )

@@ -144,48 +144,48 @@ class Section:
     body: str
 
 
-def _signed(value: float, interval: tuple[float, float], digits: int) -> str:
-    """``+0.12 [-0.05, +0.30]``: an estimate with its interval (``-`` for an interval one run cannot give)."""
+def _with_interval(value: float, interval: tuple[float, float], spec: str) -> str:
+    """``value`` and its interval in the format ``spec``, e.g. ``+0.12 [-0.05, +0.30]`` for ``"+.2f"``; the value
+    alone where one run gives no interval (NaN bounds)."""
     if np.isnan(interval[0]):
-        return f"{value:+.{digits}f}"
-    return f"{value:+.{digits}f} [{interval[0]:+.{digits}f}, {interval[1]:+.{digits}f}]"
+        return f"{value:{spec}}"
+    return f"{value:{spec}} [{interval[0]:{spec}}, {interval[1]:{spec}}]"
 
 
-def comparison_sections(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> dict[str, Section]:
-    """How far the seeds resolve each comparison of ``pairs`` (``(A, B)``: A compared with B).
-
-    ``comparison_tasks`` (pairs with runs of both on two tasks or more): IQM(A) - IQM(B) and P(A > B) on the min-max
-    normalized final returns of the IQM table, with 95 % bootstrap intervals. ``comparison_per_task``: per task
-    where both ran, mean final return of A minus B and mean SM of A minus B with 95 % bootstrap intervals, and the
-    seeds per agent that would resolve the return difference (sb3_gqn.significance.seeds_to_resolve).
-    """
-    sections: dict[str, Section] = {}
+def comparisons_across_tasks(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> Section | None:
+    """IQM(A) - IQM(B) and P(A > B) on the min-max normalized final returns of the IQM table, with 95 % bootstrap
+    intervals, for each pair ``(A, B)`` of ``pairs`` with runs of both on every task (None if no pair has, or the
+    table has one task)."""
     scores, tasks = normalized_final_scores(table)
-    across = []
+    rows = []
     for first, second in pairs:
         if first in scores and second in scores and len(tasks) > 1:
             iqm, iqm_interval = difference_interval(iqm_difference, scores[first], scores[second], reps)
             improvement, improvement_interval = difference_interval(
                 probability_of_improvement, scores[first], scores[second], reps
             )
-            across.append(
+            rows.append(
                 {
                     "A vs B": f"{first} vs {second}",
                     "runs per task": f"{scores[first].shape[0]} / {scores[second].shape[0]}",
-                    "IQM(A) - IQM(B) (95 % CI)": _signed(iqm, iqm_interval, 2),
-                    "P(A > B) (95 % CI)": f"{improvement:.2f}"
-                    if np.isnan(improvement_interval[0])
-                    else f"{improvement:.2f} [{improvement_interval[0]:.2f}, {improvement_interval[1]:.2f}]",
+                    "IQM(A) - IQM(B) (95 % CI)": _with_interval(iqm, iqm_interval, "+.2f"),
+                    "P(A > B) (95 % CI)": _with_interval(improvement, improvement_interval, ".2f"),
                 }
             )
-    if across:
-        sections["comparison_tasks"] = Section(
-            f"Comparisons across {len(tasks)} tasks (normalized final return, the IQM table's runs; P(A > B) = 0.5 is a tie)",
-            _markdown(pd.DataFrame(across)),
-        )
-    final = final_rows(table)
-    per_task = []
-    for (env, penalty), runs in final.groupby(["env", "penalty"]):
+    if not rows:
+        return None
+    return Section(
+        f"Comparisons across {len(tasks)} tasks (normalized final return, the IQM table's runs; P(A > B) = 0.5 is a tie)",
+        _markdown(pd.DataFrame(rows)),
+    )
+
+
+def comparisons_per_task(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> Section | None:
+    """Per task where both A and B ran: mean final return of A minus B and mean SM of A minus B with 95 % bootstrap
+    intervals, and the seeds per agent that would resolve the return difference
+    (sb3_gqn.significance.seeds_to_resolve). None if no pair ran together on any task."""
+    rows = []
+    for (env, penalty), runs in final_rows(table).groupby(["env", "penalty"]):
         for first, second in pairs:
             runs_first, runs_second = runs[runs["algo"] == first], runs[runs["algo"] == second]
             if runs_first.empty or runs_second.empty:
@@ -195,23 +195,34 @@ def comparison_sections(table: pd.DataFrame, pairs: list[tuple[str, str]], reps:
             difference, interval = difference_interval(mean_difference, *returns, reps)
             sm_difference, sm_interval = difference_interval(mean_difference, *smoothness, reps)
             enough = min(len(returns[0]), len(returns[1])) >= 2
-            per_task.append(
+            rows.append(
                 {
                     "env": f"{str(env).replace('dm_control/', '')} c={penalty:g}",
                     "A vs B": f"{first} vs {second}",
                     "seeds": f"{len(returns[0])} / {len(returns[1])}",
-                    "mean return A - B (95 % CI)": _signed(difference, interval, 0),
+                    "mean return A - B (95 % CI)": _with_interval(difference, interval, "+.0f"),
                     "seeds to resolve it": "-" if not enough else f"{seeds_to_resolve(*returns):.0f}",
-                    "mean SM A - B (95 % CI)": _signed(sm_difference, sm_interval, 4),
+                    "mean SM A - B (95 % CI)": _with_interval(sm_difference, sm_interval, "+.4f"),
                 }
             )
-    if per_task:
-        sections["comparison_per_task"] = Section(
-            "Comparisons per task (final return and SM, A minus B; seeds per agent for a test at 5 % to detect the "
-            "return difference with 80 % power)",
-            _markdown(pd.DataFrame(per_task)),
-        )
-    return sections
+    if not rows:
+        return None
+    return Section(
+        "Comparisons per task (final return and SM, A minus B; seeds per agent for a test at 5 % to detect the "
+        "return difference with 80 % power)",
+        _markdown(pd.DataFrame(rows)),
+    )
+
+
+def comparison_sections(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> dict[str, Section]:
+    """How far the seeds resolve each comparison of ``pairs`` (``(A, B)``: A compared with B), by key:
+    ``comparison_tasks`` (:func:`comparisons_across_tasks`) and ``comparison_per_task`` (:func:`comparisons_per_task`)
+    where the table has them."""
+    sections = {
+        "comparison_tasks": comparisons_across_tasks(table, pairs, reps),
+        "comparison_per_task": comparisons_per_task(table, pairs, reps),
+    }
+    return {key: section for key, section in sections.items() if section is not None}
 
 
 def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None) -> dict[str, Section]:
