@@ -57,6 +57,7 @@ ENTRIES_BEFORE_ISSUE_11: dict[str, dict[str, Any]] = {
     "dm_control/finger-spin-v0": {"train_freq": 2, "policy_kwargs": None},
 }
 REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
+RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
 #: Algorithm variants: (rl-zoo3 algorithm, hyperparameter overrides on its shipped file)
 VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-adaptive": ("gqn", {"growth": "adaptive"}),
@@ -79,6 +80,14 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-linear+layernorm+1update": ("gqn", {"growth": "linear", "policy_kwargs": REFERENCE_TORSO, "train_freq": 1}),
     "decqn-2+layernorm+1update": ("decqn", {"bins": 2, "policy_kwargs": REFERENCE_TORSO, "train_freq": 1}),
     "decqn-9+layernorm+1update": ("decqn", {"bins": 9, "policy_kwargs": REFERENCE_TORSO, "train_freq": 1}),
+    # DecQN's residual torso as its reference experiments run it (use_residual=True): LayerNorm(x + MLP(x)) + ELU
+    # and VarianceScaling(1/3) initialization, at cartpole's 1 update per 2 env steps and walker's/finger's 1 per step
+    "gqn-adaptive+residual": ("gqn", {"growth": "adaptive", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 2}),
+    "gqn-adaptive+residual+1update": ("gqn", {"growth": "adaptive", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
+    "decqn-9+residual": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 2}),
+    "decqn-9+residual+1update": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
+    # two critics (DecQN's use_double_q) on the entry's own torso and update ratio
+    "gqn-adaptive+twin": ("gqn", {"growth": "adaptive", "policy_kwargs": "dict(n_critics=2)"}),
 }
 ABLATION = ["gqn-before", "gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared", "gqn-adaptive"]
 SHORT_SUITE = dict(

@@ -33,7 +33,7 @@ from sb3_gqn.growth import (
 from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, active_bin_mask, epsilon_greedy
 from sb3_gqn.nstep_dict import NStepDictReplayBuffer
 from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
-from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
+from sb3_gqn.targets import critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.wrappers import BinGrid
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
@@ -147,7 +147,8 @@ class GQN(OffPolicyAlgorithm):
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
     :param policy_kwargs: additional arguments to be passed to the policy on creation
-        (``net_arch``, ``layer_norm``, ``residual``, ...; see :class:`~sb3_gqn.policies.GQNPolicy`)
+        (``net_arch``, ``layer_norm``, ``residual``, ``residual_layer_norm``, ``n_critics``, ...; see
+        :class:`~sb3_gqn.policies.GQNPolicy`)
     :param verbose: the verbosity level: 0 no output, 1 info (including growth events), 2 debug
     :param seed: Seed for the pseudo random generators
     :param device: Device (cpu, cuda, ...) on which the code should be run.
@@ -334,8 +335,12 @@ class GQN(OffPolicyAlgorithm):
                 "(or a pair ending in it) for a Discrete/MultiDiscrete env"
             )
         # Copy running stats, see https://github.com/DLR-RM/stable-baselines3/issues/996
-        self.batch_norm_stats = get_parameters_by_name(self.q_net, ["running_"])
-        self.batch_norm_stats_target = get_parameters_by_name(self.q_net_target, ["running_"])
+        self.batch_norm_stats = [
+            stat for online, _ in self.policy.critics for stat in get_parameters_by_name(online, ["running_"])
+        ]
+        self.batch_norm_stats_target = [
+            stat for _, target in self.policy.critics for stat in get_parameters_by_name(target, ["running_"])
+        ]
         self.exploration_schedule = LinearSchedule(
             self.exploration_initial_eps, self.exploration_final_eps, self.exploration_fraction
         )
@@ -503,36 +508,40 @@ class GQN(OffPolicyAlgorithm):
         if prioritized:
             self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)
 
+        critics = self.policy.critics
+        online_parameters = [parameter for online, _ in critics for parameter in online.parameters()]
         losses, q_values = [], []
         for _ in range(gradient_steps):
             replay_data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]
             # n-step replay returns gamma ** k (k = steps actually summed); plain replay uses gamma
             discounts = replay_data.discounts if replay_data.discounts is not None else self.gamma
 
+            weights = replay_data.weights if prioritized else None
+            actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
             with th.no_grad():
                 # Eq. 3 with double Q (eq. 1): the online net picks a^j in A^g at s_{t+n}, the target net scores it
-                target = double_q_target(
-                    self.q_net(replay_data.next_observations),
-                    self.q_net_target(replay_data.next_observations),
+                # (with n_critics > 1, DecQN's use_double_q: each critic's online net picks, the mean of the target
+                # nets scores)
+                targets = critic_ensemble_targets(
+                    [online(replay_data.next_observations) for online, _ in critics],
+                    [target_net(replay_data.next_observations) for _, target_net in critics],
                     replay_data.rewards,
                     replay_data.dones,
                     discounts,
                     active_bins_mask,
                 )
-
             # Eq. 2: Q(s_t, a_t) is the mean over dimensions of the chosen bins' utilities
-            actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
-            current = decoupled_q_value(self.q_net(replay_data.observations), actions)
-
-            # Eq. 1: Huber loss on the TD error, weighted by (N P(i))^-beta under prioritized replay
-            loss, abs_td_errors = huber_td_loss(current, target, replay_data.weights if prioritized else None)
+            currents = [decoupled_q_value(online(replay_data.observations), actions) for online, _ in critics]
+            # Eq. 1: Huber loss on the TD error, weighted by (N P(i))^-beta under prioritized replay (several critics:
+            # the losses add up, the new priorities are the mean |TD error|)
+            loss, abs_td_errors = critic_ensemble_loss(currents, targets, weights)
             losses.append(loss.detach())
-            q_values.append(current.detach().mean())
+            q_values.append(currents[0].detach().mean())
 
             self.policy.optimizer.zero_grad(set_to_none=True)
             loss.backward()
             if self.max_grad_norm is not None:
-                clip_grad_norm(self.q_net.parameters(), self.max_grad_norm)
+                clip_grad_norm(online_parameters, self.max_grad_norm)
             self.policy.optimizer.step()
             if prioritized:  # the TD errors become the sampled transitions' new priorities
                 # (after the step: the backward pass still finds the forward's activations in cache, ~3 % faster)
@@ -540,7 +549,8 @@ class GQN(OffPolicyAlgorithm):
 
             self._n_updates += 1
             if self._n_updates % self.target_update_interval == 0:
-                polyak_update(self.q_net.parameters(), self.q_net_target.parameters(), self.tau)
+                for online, target_net in critics:
+                    polyak_update(online.parameters(), target_net.parameters(), self.tau)
                 # Copy running stats, see https://github.com/DLR-RM/stable-baselines3/issues/996
                 polyak_update(self.batch_norm_stats, self.batch_norm_stats_target, 1.0)
 

@@ -15,6 +15,8 @@ import pandas as pd
 import torch as th
 from stable_baselines3.common.callbacks import BaseCallback
 
+from sb3_gqn.significance import seeded_numpy_global_generator
+
 #: Figure 4's axes: column of results.csv -> label
 RADAR_METRICS = {
     "task_return": "R",
@@ -178,12 +180,16 @@ def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:
     return [(str(env), float(c)) for (env, c), row in task_range.iterrows() if row["max"] == row["min"]]
 
 
-def iqm_with_intervals(scores: dict[str, np.ndarray], reps: int = 2000) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``)."""
+def iqm_with_intervals(
+    scores: dict[str, np.ndarray], reps: int = 2000, seed: int = 0
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``); ``seed``
+    fixes the bootstrap draws, so that a regenerated table or figure reads the same."""
     from rliable import library as rly
     from rliable import metrics as rly_metrics
 
-    return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
+    with seeded_numpy_global_generator(seed):
+        return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
 
 
 def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:

@@ -20,6 +20,9 @@ from stable_baselines3.common.type_aliases import PyTorchObs, Schedule
 from torch import nn
 
 from sb3_gqn.masking import masked_argmax
+from sb3_gqn.torsos import DecoupledMLP, ResidualLayerNormMLP, variance_scaling_uniform_
+
+__all__ = ["CnnPolicy", "DecoupledMLP", "DecoupledQNetwork", "GQNPolicy", "MlpPolicy", "MultiInputPolicy"]
 
 # Layers whose output depends on ``module.training`` (SB3's own policies switch modes for these).
 _MODE_DEPENDENT_LAYERS = (nn.modules.dropout._DropoutNd, nn.modules.batchnorm._NormBase)
@@ -50,53 +53,15 @@ def decoupled_action_shape(action_space: spaces.Space) -> tuple[int, int]:
     )
 
 
-class DecoupledMLP(nn.Module):
-    """MLP torso of the decoupled critic.
-
-    Plain: ``Linear -> activation`` per hidden layer. With ``layer_norm`` it is DecQN's torso (Acme's
-    ``LayerNormMLP``): the first layer is ``Linear -> LayerNorm -> tanh``, which keeps the features of
-    unnormalized observations in a fixed range, and the others ``Linear -> activation``. With
-    ``residual``, blocks whose input and output sizes match add their input to their output.
-
-    :param input_dim: features dimension
-    :param net_arch: hidden layer sizes
-    :param activation_fn: activation class of the hidden layers (after the first one with ``layer_norm``)
-    :param layer_norm: LayerNorm and tanh after the first layer
-    :param residual: residual connections between equal-size hidden blocks
-    """
-
-    def __init__(
-        self,
-        input_dim: int,
-        net_arch: list[int],
-        activation_fn: type[nn.Module] = nn.ReLU,
-        layer_norm: bool = False,
-        residual: bool = False,
-    ):
-        super().__init__()
-        self.blocks = nn.ModuleList()
-        self.skips: list[bool] = []
-        last_dim = input_dim
-        for index, size in enumerate(net_arch):
-            if layer_norm and index == 0:
-                block = nn.Sequential(nn.Linear(last_dim, size), nn.LayerNorm(size), nn.Tanh())
-            else:
-                block = nn.Sequential(nn.Linear(last_dim, size), activation_fn())
-            self.blocks.append(block)
-            self.skips.append(residual and size == last_dim)
-            last_dim = size
-        self.output_dim = last_dim
-
-    def forward(self, features: th.Tensor) -> th.Tensor:
-        hidden = features
-        for block, skip in zip(self.blocks, self.skips, strict=True):
-            output = hidden
-            # Each layer's ``forward`` directly: at batch 1 the module-call machinery (hook dispatch) costs about as
-            # much as the matmuls themselves (sb3-gqn adds no hooks; ``register_forward_hook`` on layers is not run).
-            for layer in block:
-                output = layer.forward(output)
-            hidden = hidden + output if skip else output
-        return hidden
+def check_residual_layer_norm_options(layer_norm: bool, residual: bool, activation_fn: type[nn.Module]) -> None:
+    """``residual_layer_norm`` is a whole torso: raise ``ValueError`` for the options it would otherwise ignore."""
+    if layer_norm or residual:
+        raise ValueError("residual_layer_norm=True is a torso of its own: leave layer_norm and residual False")
+    if activation_fn is not nn.ReLU:
+        raise ValueError(
+            "residual_layer_norm=True fixes its activations (ReLU inside each block, ELU after the torso): "
+            f"leave activation_fn at its default, got {activation_fn.__name__}"
+        )
 
 
 class DecoupledQNetwork(BasePolicy):
@@ -113,6 +78,10 @@ class DecoupledQNetwork(BasePolicy):
     :param activation_fn: activation function
     :param layer_norm: LayerNorm in each hidden block
     :param residual: residual connections between equal-size hidden blocks
+    :param residual_layer_norm: DecQN's residual torso as its reference runs it
+        (:class:`~sb3_gqn.torsos.ResidualLayerNormMLP`: ``LayerNorm(x + MLP(x))`` + ELU, ``net_arch = [width] * (1 +
+        blocks)``) and its head initialization (:func:`~sb3_gqn.torsos.variance_scaling_uniform_`); excludes
+        ``layer_norm``, ``residual`` and ``activation_fn``
     :param normalize_images: whether to divide images by 255
     """
 
@@ -126,6 +95,7 @@ class DecoupledQNetwork(BasePolicy):
         activation_fn: type[nn.Module] = nn.ReLU,
         layer_norm: bool = False,
         residual: bool = False,
+        residual_layer_norm: bool = False,
         normalize_images: bool = True,
     ):
         super().__init__(
@@ -138,10 +108,17 @@ class DecoupledQNetwork(BasePolicy):
         self.activation_fn = activation_fn
         self.layer_norm = layer_norm
         self.residual = residual
+        self.residual_layer_norm = residual_layer_norm
         self.features_dim = features_dim
         self.action_dims, self.max_bins = decoupled_action_shape(action_space)
-        self.torso = DecoupledMLP(features_dim, self.net_arch, activation_fn, layer_norm, residual)
-        self.head = nn.Linear(self.torso.output_dim, self.action_dims * self.max_bins)
+        self.torso: DecoupledMLP | ResidualLayerNormMLP
+        if residual_layer_norm:
+            check_residual_layer_norm_options(layer_norm, residual, activation_fn)
+            self.torso = ResidualLayerNormMLP(features_dim, self.net_arch)
+            self.head = variance_scaling_uniform_(nn.Linear(self.torso.output_dim, self.action_dims * self.max_bins))
+        else:
+            self.torso = DecoupledMLP(features_dim, self.net_arch, activation_fn, layer_norm, residual)
+            self.head = nn.Linear(self.torso.output_dim, self.action_dims * self.max_bins)
         # A flat vector observation needs no preprocessing beyond float() and flatten (SB3's preprocess_obs and
         # FlattenExtractor do exactly that), so the forward pass skips their calls.
         self.flat_vector_observations = (
@@ -154,7 +131,7 @@ class DecoupledQNetwork(BasePolicy):
         # ~6 us, a fifth of the matmuls). The layers are this network's own modules: updates, load_state_dict and
         # .to() act on them; replacing a layer object afterwards is not supported.
         self.layer_chain: list[Callable[[th.Tensor], th.Tensor]] | None = None
-        if not any(self.torso.skips):
+        if isinstance(self.torso, DecoupledMLP) and not any(self.torso.skips):
             self.layer_chain = [layer.forward for block in self.torso.blocks for layer in block] + [self.head.forward]
 
     def forward(self, obs: PyTorchObs) -> th.Tensor:
@@ -186,6 +163,7 @@ class DecoupledQNetwork(BasePolicy):
                 activation_fn=self.activation_fn,
                 layer_norm=self.layer_norm,
                 residual=self.residual,
+                residual_layer_norm=self.residual_layer_norm,
                 features_extractor=self.features_extractor,
             )
         )
@@ -205,16 +183,25 @@ class GQNPolicy(BasePolicy):
     :param activation_fn: Activation function
     :param layer_norm: LayerNorm in each hidden block
     :param residual: residual connections between equal-size hidden blocks
+    :param residual_layer_norm: DecQN's residual torso as its reference runs it (``LayerNorm(x + MLP(x))`` + ELU,
+        see :class:`~sb3_gqn.torsos.ResidualLayerNormMLP`) and its head initialization; excludes ``layer_norm``,
+        ``residual`` and ``activation_fn``
     :param features_extractor_class: Features extractor to use.
     :param features_extractor_kwargs: Keyword arguments to pass to the features extractor.
     :param normalize_images: Whether to normalize images or not, dividing by 255.0 (True by default)
     :param optimizer_class: The optimizer to use, ``th.optim.Adam`` by default
     :param optimizer_kwargs: Additional keyword arguments, excluding the learning rate, to pass to the
         optimizer. Adam defaults to ``fused=True`` (one kernel for all parameters, ~5x faster on CPU).
+    :param n_critics: number of decoupled critics, each with its target network (DecQN's reference runs two,
+        ``use_double_q``): greedy actions take the element-wise maximum of their utilities, and each critic learns
+        towards the mean of the target critics' utilities at the bins its own online network selects (see
+        :func:`~sb3_gqn.targets.critic_ensemble_targets`). ``q_net`` and ``q_net_target`` are the first critic's.
     """
 
     q_net: DecoupledQNetwork
     q_net_target: DecoupledQNetwork
+    extra_q_nets: nn.ModuleList
+    extra_q_nets_target: nn.ModuleList
     active_bins_mask: th.Tensor
 
     def __init__(
@@ -226,11 +213,13 @@ class GQNPolicy(BasePolicy):
         activation_fn: type[nn.Module] = nn.ReLU,
         layer_norm: bool = False,
         residual: bool = False,
+        residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = FlattenExtractor,
         features_extractor_kwargs: dict[str, Any] | None = None,
         normalize_images: bool = True,
         optimizer_class: type[th.optim.Optimizer] = th.optim.Adam,
         optimizer_kwargs: dict[str, Any] | None = None,
+        n_critics: int = 1,
     ):
         if optimizer_kwargs is None:
             optimizer_kwargs = {"fused": True} if optimizer_class is th.optim.Adam else {}
@@ -247,6 +236,12 @@ class GQNPolicy(BasePolicy):
         self.activation_fn = activation_fn
         self.layer_norm = layer_norm
         self.residual = residual
+        self.residual_layer_norm = residual_layer_norm
+        if residual_layer_norm:
+            check_residual_layer_norm_options(layer_norm, residual, activation_fn)
+        if not isinstance(n_critics, int) or n_critics < 1:
+            raise ValueError(f"n_critics must be a positive integer, got {n_critics!r}")
+        self.n_critics = n_critics
         self.action_dims, self.max_bins = decoupled_action_shape(action_space)
         self._discrete_actions = isinstance(action_space, spaces.Discrete)  # one dimension, actions without a last axis
         self.register_buffer("active_bins_mask", th.ones(self.max_bins, dtype=th.bool))
@@ -257,6 +252,7 @@ class GQNPolicy(BasePolicy):
             "activation_fn": self.activation_fn,
             "layer_norm": self.layer_norm,
             "residual": self.residual,
+            "residual_layer_norm": self.residual_layer_norm,
             "normalize_images": normalize_images,
         }
         self._build(lr_schedule)
@@ -264,15 +260,32 @@ class GQNPolicy(BasePolicy):
     def _build(self, lr_schedule: Schedule) -> None:
         self.q_net = self.make_q_net()
         self.q_net_target = self.make_q_net()
-        self.q_net_target.load_state_dict(self.q_net.state_dict())
-        self.q_net_target.set_training_mode(False)
+        # Further critics (empty with one critic: the state dict is the single critic's)
+        self.extra_q_nets = nn.ModuleList(self.make_q_net() for _ in range(self.n_critics - 1))
+        self.extra_q_nets_target = nn.ModuleList(self.make_q_net() for _ in range(self.n_critics - 1))
+        for online, target in self.critics:
+            target.load_state_dict(online.state_dict())
+            target.set_training_mode(False)
         self._mode_dependent = any(isinstance(module, _MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
-        # Only the online network is optimized (the target net's parameters stay out of the optimizer)
+        # Only the online networks are optimized (the target nets' parameters stay out of the optimizer)
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
-            self.q_net.parameters(),
+            [parameter for online, _ in self.critics for parameter in online.parameters()],
             lr=lr_schedule(1),
             **self.optimizer_kwargs,
         )
+
+    @property
+    def critics(self) -> list[tuple[DecoupledQNetwork, DecoupledQNetwork]]:
+        """``(online, target)`` network of every critic, the first one's (``q_net``, ``q_net_target``) first."""
+        return [(self.q_net, self.q_net_target), *zip(self.extra_q_nets, self.extra_q_nets_target, strict=True)]  # type: ignore[list-item]
+
+    def greedy_utilities(self, obs: PyTorchObs) -> th.Tensor:
+        """The utilities greedy actions maximize: the online critic's, or with several critics their element-wise
+        maximum (DecQN's reference acts on ``max(Q1, Q2)``); ``(batch, action_dims, max_bins)``."""
+        utilities = self.q_net.forward(obs)
+        for critic in self.extra_q_nets:
+            utilities = th.maximum(utilities, critic.forward(obs))
+        return utilities
 
     def make_q_net(self) -> DecoupledQNetwork:
         # Make sure we always have separate networks for features extractors etc
@@ -289,12 +302,12 @@ class GQNPolicy(BasePolicy):
     @th.no_grad()
     def interpolate_bins(self, neighbours: list[tuple[int, int, int]]) -> None:
         """Warm-start newly opened bins: each ``(new, left, right)`` bin's head row (weights and bias) becomes
-        the mean of its neighbours' rows, in every action dimension of the online and the target network.
+        the mean of its neighbours' rows, in every action dimension of the online and the target network of every critic.
 
         The head is linear in the torso's features, so afterwards ``Q^j(s, new) = (Q^j(s, left) + Q^j(s, right)) / 2``
-        in every state: the greedy policy does not jump to an untrained bin when the level opens.
+        in every state, for every critic: the greedy policy does not jump to an untrained bin when the level opens.
         """
-        for network in (self.q_net, self.q_net_target):
+        for network in (network for critic in self.critics for network in critic):
             weight = network.head.weight.view(self.action_dims, self.max_bins, -1)
             bias = network.head.bias.view(self.action_dims, self.max_bins)
             for new, left, right in neighbours:
@@ -306,7 +319,7 @@ class GQNPolicy(BasePolicy):
 
     def _predict(self, obs: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         """Greedy bin per dimension over the active set (paper eq. 3); shape ``(batch, action_dims)``."""
-        actions = masked_argmax(self.q_net.forward(obs), self.active_bins_mask)
+        actions = masked_argmax(self.greedy_utilities(obs), self.active_bins_mask)
         if self._discrete_actions:
             return actions.squeeze(-1)
         return actions
@@ -319,9 +332,11 @@ class GQNPolicy(BasePolicy):
                 activation_fn=self.net_args["activation_fn"],
                 layer_norm=self.layer_norm,
                 residual=self.residual,
+                residual_layer_norm=self.residual_layer_norm,
                 lr_schedule=self._dummy_schedule,  # dummy lr schedule, not needed for loading policy alone
                 optimizer_class=self.optimizer_class,
                 optimizer_kwargs=self.optimizer_kwargs,
+                n_critics=self.n_critics,
                 features_extractor_class=self.features_extractor_class,
                 features_extractor_kwargs=self.features_extractor_kwargs,
             )
@@ -336,10 +351,11 @@ class GQNPolicy(BasePolicy):
         otherwise only the policy's and the online network's own flags change.
         """
         if self.q_net.training != mode or self.training != mode:
-            if self._mode_dependent:
-                self.q_net.set_training_mode(mode)
-            else:
-                self.q_net.training = mode
+            for online, _ in self.critics:
+                if self._mode_dependent:
+                    online.set_training_mode(mode)
+                else:
+                    online.training = mode
             self.training = mode
 
     @property
@@ -433,11 +449,13 @@ class CnnPolicy(GQNPolicy):
         activation_fn: type[nn.Module] = nn.ReLU,
         layer_norm: bool = False,
         residual: bool = False,
+        residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = NatureCNN,
         features_extractor_kwargs: dict[str, Any] | None = None,
         normalize_images: bool = True,
         optimizer_class: type[th.optim.Optimizer] = th.optim.Adam,
         optimizer_kwargs: dict[str, Any] | None = None,
+        n_critics: int = 1,
     ):
         super().__init__(
             observation_space,
@@ -447,11 +465,13 @@ class CnnPolicy(GQNPolicy):
             activation_fn,
             layer_norm,
             residual,
+            residual_layer_norm,
             features_extractor_class,
             features_extractor_kwargs,
             normalize_images,
             optimizer_class,
             optimizer_kwargs,
+            n_critics,
         )
 
 
@@ -467,11 +487,13 @@ class MultiInputPolicy(GQNPolicy):
         activation_fn: type[nn.Module] = nn.ReLU,
         layer_norm: bool = False,
         residual: bool = False,
+        residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = CombinedExtractor,
         features_extractor_kwargs: dict[str, Any] | None = None,
         normalize_images: bool = True,
         optimizer_class: type[th.optim.Optimizer] = th.optim.Adam,
         optimizer_kwargs: dict[str, Any] | None = None,
+        n_critics: int = 1,
     ):
         super().__init__(
             observation_space,
@@ -481,9 +503,11 @@ class MultiInputPolicy(GQNPolicy):
             activation_fn,
             layer_norm,
             residual,
+            residual_layer_norm,
             features_extractor_class,
             features_extractor_kwargs,
             normalize_images,
             optimizer_class,
             optimizer_kwargs,
+            n_critics,
         )

@@ -18,9 +18,27 @@ rliable and scipy come with the ``benchmark`` extra, as for the IQM.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 import numpy as np
+
+
+@contextmanager
+def seeded_numpy_global_generator(seed: int) -> Iterator[None]:
+    """Seed NumPy's global generator inside the block and put its previous state back afterwards.
+
+    rliable's bootstraps (``StratifiedIndependentBootstrap``, used by ``get_interval_estimates``) draw from NumPy's
+    global generator: their ``random_state`` argument does not reach the draws. Every interval this package reports
+    is computed inside this block, so a regenerated table or figure reads the same and the caller's random stream
+    is left as it was.
+    """
+    global_state = np.random.get_state()
+    np.random.seed(seed)
+    try:
+        yield
+    finally:
+        np.random.set_state(global_state)
 
 
 def iqm_difference(scores_x: np.ndarray, scores_y: np.ndarray) -> float:
@@ -70,16 +88,10 @@ def difference_interval(
     if min(pair[0].shape[0], pair[1].shape[0]) < 2:
         value = statistic(*pair)
         return value, (math.nan, math.nan)  # one run: nothing to resample
-    # rliable's independent bootstrap draws from NumPy's global generator (its random_state does not reach the
-    # draws): seed that for the call and put its state back afterwards
-    global_state = np.random.get_state()
-    np.random.seed(seed)
-    try:
+    with seeded_numpy_global_generator(seed):
         estimates, intervals = library.get_interval_estimates(
             {"pair": pair}, lambda x, y: np.array([statistic(x, y)]), reps=reps
         )
-    finally:
-        np.random.set_state(global_state)
     return float(estimates["pair"][0]), (float(intervals["pair"][0, 0]), float(intervals["pair"][1, 0]))
 
 

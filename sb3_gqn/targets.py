@@ -66,3 +66,49 @@ def huber_td_loss(
     if weights is not None:
         per_sample = per_sample * weights.reshape(-1)
     return per_sample.mean(), (target - current).detach().abs()
+
+
+def critic_ensemble_targets(
+    next_q_online: list[th.Tensor],
+    next_q_target: list[th.Tensor],
+    rewards: th.Tensor,
+    dones: th.Tensor,
+    discounts: th.Tensor | float,
+    active_bins_mask: th.Tensor,
+) -> list[th.Tensor]:
+    """:func:`double_q_target` for each of several critics, as DecQN's reference learns its two (``use_double_q``).
+
+    The target networks' utilities are averaged element-wise, ``Q_target = (1/K) sum_k Q_target_k``; critic ``k``'s
+    target takes each dimension's bin from its own online network and scores it with that average:
+    ``y_k = R^(n) + gamma^n (1 - done) (1 / M) sum_j Q^j_target(s', argmax_{a in A^g} Q^j_online_k(s', a))``.
+    With one critic this is :func:`double_q_target`.
+
+    :param next_q_online: each critic's online utilities at ``s_{t+n}``, ``(batch, action_dims, max_bins)``
+    :param next_q_target: each critic's target-network utilities at ``s_{t+n}``, same shape
+    :return: one target ``(batch,)`` per critic
+    """
+    if len(next_q_online) != len(next_q_target) or not next_q_online:
+        raise ValueError(f"need one target network per critic, got {len(next_q_online)} and {len(next_q_target)}")
+    mean_target = next_q_target[0] if len(next_q_target) == 1 else th.stack(next_q_target).mean(dim=0)
+    return [double_q_target(online, mean_target, rewards, dones, discounts, active_bins_mask) for online in next_q_online]
+
+
+def critic_ensemble_loss(
+    currents: list[th.Tensor],
+    targets: list[th.Tensor],
+    weights: th.Tensor | None = None,
+) -> tuple[th.Tensor, th.Tensor]:
+    """The critics' summed :func:`huber_td_loss` (DecQN's reference: ``loss1 + loss2``) and the mean over critics of
+    the per-sample absolute TD errors (its new priorities: ``0.5 * (|td1| + |td2|)``).
+
+    :param currents: each critic's ``Q_k(s_t, a_t)``, ``(batch,)``
+    :param targets: each critic's ``y_k``, ``(batch,)``
+    :param weights: importance-sampling weights as for :func:`huber_td_loss`
+    """
+    if len(currents) == 1:
+        return huber_td_loss(currents[0], targets[0], weights)
+    losses, abs_td_errors = zip(
+        *(huber_td_loss(current, target, weights) for current, target in zip(currents, targets, strict=True)),
+        strict=True,
+    )
+    return th.stack(losses).sum(), th.stack(abs_td_errors).mean(dim=0)

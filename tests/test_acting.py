@@ -82,12 +82,16 @@ def test_plain_networks_skip_the_module_tree_walk():
     assert layer.training  # nothing below the online network's own flag is touched: no layer reads it
 
 
-@pytest.mark.parametrize("policy_kwargs", [dict(), dict(layer_norm=True, activation_fn=nn.ELU), dict(residual=True)])
+@pytest.mark.parametrize(
+    "policy_kwargs",
+    [dict(), dict(layer_norm=True, activation_fn=nn.ELU), dict(residual=True), dict(residual_layer_norm=True)],
+)
 def test_the_layer_chain_computes_the_module_tree(policy_kwargs):
     """The flat chain of layer forwards used for speed gives exactly what torso and head compute."""
     model = GQN("MlpPolicy", DecliningEnv(action_dims=3), policy_kwargs=dict(net_arch=[64, 64], **policy_kwargs), seed=0)
     q_net = model.q_net
-    assert (q_net.layer_chain is None) == bool(policy_kwargs.get("residual"))  # residual blocks keep the tree
+    residual = policy_kwargs.get("residual") or policy_kwargs.get("residual_layer_norm")
+    assert (q_net.layer_chain is None) == bool(residual)  # residual blocks keep the tree
     observations = th.randn(32, 3)
     with th.no_grad():
         model.q_net.head.bias.add_(0.5)  # parameters changed after construction are seen by the chain

@@ -13,6 +13,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
 from sb3_gqn import GQN
 from sb3_gqn.export import DeployedPolicy, export_onnx, export_torchscript
+from sb3_gqn.masking import masked_argmax
 
 onnxruntime = pytest.importorskip("onnxruntime")
 pytest.importorskip("onnxscript")
@@ -78,6 +79,11 @@ IMAGE_SPACE = spaces.Box(0, 255, (3, 36, 36), dtype=np.uint8)  # channel-first, 
 def models() -> dict[str, tuple[GQN, spaces.Space]]:
     return {
         "mlp": (grown_model(ObservationEnv(MLP_SPACE)), MLP_SPACE),
+        # two critics (greedy on their element-wise maximum) on DecQN's residual torso
+        "twin-residual": (
+            grown_model(ObservationEnv(MLP_SPACE), policy_kwargs=dict(n_critics=2, residual_layer_norm=True)),
+            MLP_SPACE,
+        ),
         "dict": (
             grown_model(ObservationEnv(DICT_SPACE), "MultiInputPolicy", n_steps=1, prioritized_replay=False),
             DICT_SPACE,
@@ -100,7 +106,7 @@ def trained_models():
     return models()
 
 
-@pytest.mark.parametrize("kind", ["mlp", "dict", "image"])
+@pytest.mark.parametrize("kind", ["mlp", "twin-residual", "dict", "image"])
 @pytest.mark.parametrize("runtime", ["torchscript", "onnx"])
 def test_exported_policy_equals_predict_on_1000_observations(trained_models, kind, runtime, tmp_path):
     model, space = trained_models[kind]
@@ -112,6 +118,11 @@ def test_exported_policy_equals_predict_on_1000_observations(trained_models, kin
         actions = run_onnx(export_onnx(model, tmp_path / "policy.onnx"), batch)
     assert actions.shape == expected.shape == (N_OBSERVATIONS, 3)
     np.testing.assert_array_equal(actions, expected)
+    if kind == "twin-residual":  # the second critic decides some of the actions: the export cannot ignore it
+        policy = model.policy
+        with th.no_grad():
+            first_only = masked_argmax(policy.q_net(th.as_tensor(batch)), policy.active_bins_mask).numpy()
+        assert (first_only != policy.predict(batch)[0]).any()
     # Only the 5 active bins' values occur: the mask is baked in
     grid = model.action_grid.values
     for dim in range(3):

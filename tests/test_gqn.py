@@ -354,7 +354,13 @@ def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
 
 
 @pytest.mark.parametrize(
-    "torso", [dict(layer_norm=True, activation_fn=th.nn.ELU), dict(residual=True), dict(layer_norm=True, residual=True)]
+    "torso",
+    [
+        dict(layer_norm=True, activation_fn=th.nn.ELU),
+        dict(residual=True),
+        dict(layer_norm=True, residual=True),
+        dict(residual_layer_norm=True),
+    ],
 )
 def test_every_torso_option_learns_grows_and_round_trips(torso, tmp_path):
     """The documented torso options (walker's shipped entry uses the first) train through growth and load back."""
@@ -363,10 +369,53 @@ def test_every_torso_option_learns_grows_and_round_trips(torso, tmp_path):
     model.learn(400)
     assert model.active_bins == 9 and model._n_updates > 0
     layers = [type(layer) for layer in model.q_net.modules()]
-    assert (th.nn.LayerNorm in layers) == bool(torso.get("layer_norm"))
+    assert (th.nn.LayerNorm in layers) == bool(torso.get("layer_norm") or torso.get("residual_layer_norm"))
     observations = np.random.default_rng(0).normal(size=(64, 3)).astype(np.float32)
     expected, _ = model.predict(observations, deterministic=True)
     model.save(tmp_path / "gqn")
     loaded = GQN.load(tmp_path / "gqn", env=DecliningEnv())
     np.testing.assert_array_equal(loaded.predict(observations, deterministic=True)[0], expected)
     loaded.learn(100, reset_num_timesteps=False)
+
+
+def test_two_critics_act_on_their_maximum_learn_both_grow_both_and_round_trip(tmp_path):
+    """policy_kwargs n_critics=2 (DecQN's use_double_q): both critics train, greedy actions maximize the element-wise
+    maximum of their utilities, growth warm-starts both, and save/load keeps both and the optimizer over both."""
+    options = {**SMALL, "policy_kwargs": dict(net_arch=[32, 32], n_critics=2)}
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, **options)
+    policy = model.policy
+    assert len(policy.critics) == 2 and policy.critics[0] == (model.q_net, model.q_net_target)
+    optimized = {id(parameter) for group in policy.optimizer.param_groups for parameter in group["params"]}
+    assert optimized == {id(parameter) for online, _ in policy.critics for parameter in online.parameters()}
+    second_before = [parameter.detach().clone() for parameter in policy.extra_q_nets[0].parameters()]
+    model.learn(400)
+    assert model.active_bins == 9 and model._n_updates > 0
+    assert any(not th.equal(before, after) for before, after in zip(second_before, policy.extra_q_nets[0].parameters()))
+    observations = th.as_tensor(np.random.default_rng(0).normal(size=(64, 3)).astype(np.float32))
+    with th.no_grad():
+        utilities = th.maximum(model.q_net(observations), policy.extra_q_nets[0](observations))
+        # make the second critic decide dimension 0: its bin 3 dominates everywhere
+        policy.extra_q_nets[0].head.bias.view(2, 9)[0, 3] += 1e3
+    actions, _ = policy.predict(observations.numpy(), deterministic=True)  # bin indices
+    assert (actions[:, 0] == 3).all()
+    np.testing.assert_array_equal(actions[:, 1], utilities[:, 1].argmax(dim=-1).numpy())
+    # growth warm-starts every critic's online and target head
+    grown = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, **options)
+    grown.grow(1)
+    for online, target in grown.policy.critics:
+        for network in (online, target):
+            with th.no_grad():
+                values = network(observations)
+            th.testing.assert_close(values[..., 4], 0.5 * (values[..., 0] + values[..., 8]))
+    model.save(tmp_path / "twin")
+    loaded = GQN.load(tmp_path / "twin", env=DecliningEnv())
+    assert loaded.policy.n_critics == 2
+    np.testing.assert_array_equal(loaded.policy.predict(observations.numpy(), deterministic=True)[0], actions)
+    assert len(loaded.policy.optimizer.state) == len(optimized)  # Adam's moments of both critics came back
+    loaded.learn(100, reset_num_timesteps=False)
+
+
+@pytest.mark.parametrize("n_critics", [0, -1, 1.5])
+def test_n_critics_must_be_a_positive_integer(n_critics):
+    with pytest.raises(ValueError, match="n_critics must be a positive integer"):
+        GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(n_critics=n_critics))

@@ -67,3 +67,22 @@ def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
     assert len(snapshots) == 4  # the end of each of the 4 levels
     np.testing.assert_allclose(np.load(snapshots[0])["bin_values"], np.linspace(-2.0, 2.0, 9))  # Pendulum's torque
     assert q_value_picture(tmp_path, Path(tmp_path)).stat().st_size > 20_000
+
+
+def test_iqm_intervals_are_seeded_and_leave_the_global_numpy_stream_alone():
+    """Regenerating the README's IQM table or figure gives the same intervals (rliable draws from NumPy's global
+    generator); another seed gives other draws; the caller's stream continues where it was."""
+    from sb3_gqn.plots import iqm_with_intervals
+
+    scores = {"a": np.random.default_rng(0).random((6, 3)), "b": np.random.default_rng(1).random((5, 3))}
+    np.random.seed(7)
+    expected_draw = np.random.random()
+    np.random.seed(7)
+    estimates, intervals = iqm_with_intervals(scores, reps=300)
+    assert np.random.random() == expected_draw
+    again = iqm_with_intervals(scores, reps=300)[1]
+    other_seed = iqm_with_intervals(scores, reps=300, seed=1)[1]
+    for algo in scores:
+        np.testing.assert_array_equal(again[algo], intervals[algo])
+        assert not np.array_equal(other_seed[algo], intervals[algo])
+        assert intervals[algo][0, 0] <= estimates[algo][0] <= intervals[algo][1, 0]

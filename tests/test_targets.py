@@ -93,3 +93,42 @@ def test_clip_grad_norm_passes_a_nan_norm_on_like_pytorch():
     parameter.grad = th.tensor([float("nan"), 1.0])
     assert th.isnan(clip_grad_norm([parameter], 1.0))
     assert th.isnan(parameter.grad).all()  # multiplied by a NaN coefficient, as clip_grad_norm_ does
+
+
+def test_critic_ensemble_targets_hand_computed():
+    """DecQN's use_double_q: each critic's online net selects, the mean of the target nets scores."""
+    from sb3_gqn.targets import critic_ensemble_targets
+
+    online_1 = th.tensor([[[1.0, 3.0, 2.0]]])  # argmax 1; over the active {0, 2}: 2
+    online_2 = th.tensor([[[5.0, 0.0, 0.0]]])  # argmax 0
+    target_1 = th.tensor([[[0.0, 2.0, 4.0]]])
+    target_2 = th.tensor([[[2.0, 6.0, 0.0]]])  # mean of the target nets: [1, 4, 2]
+    rewards, dones = th.tensor([0.5]), th.tensor([0.0])
+    all_bins = th.tensor([True, True, True])
+    y_1, y_2 = critic_ensemble_targets([online_1, online_2], [target_1, target_2], rewards, dones, 0.9, all_bins)
+    assert y_1.item() == pytest.approx(0.5 + 0.9 * 4.0)  # critic 1 picks bin 1: mean target 4
+    assert y_2.item() == pytest.approx(0.5 + 0.9 * 1.0)  # critic 2 picks bin 0: mean target 1
+    coarse = th.tensor([True, False, True])
+    y_1, y_2 = critic_ensemble_targets([online_1, online_2], [target_1, target_2], rewards, dones, 0.9, coarse)
+    assert y_1.item() == pytest.approx(0.5 + 0.9 * 2.0)  # bin 1 is masked: critic 1 picks bin 2, mean target 2
+    assert y_2.item() == pytest.approx(0.5 + 0.9 * 1.0)
+    terminal = critic_ensemble_targets([online_1, online_2], [target_1, target_2], rewards, th.tensor([1.0]), 0.9, coarse)
+    assert [y.item() for y in terminal] == [0.5, 0.5]
+    # one critic: exactly double_q_target
+    (single,) = critic_ensemble_targets([online_1], [target_1], rewards, dones, 0.9, all_bins)
+    assert single.item() == pytest.approx(0.5 + 0.9 * 2.0)  # online picks bin 1, its own target scores 2
+    with pytest.raises(ValueError, match="one target network per critic"):
+        critic_ensemble_targets([online_1, online_2], [target_1], rewards, dones, 0.9, all_bins)
+
+
+def test_critic_ensemble_loss_adds_the_losses_and_averages_the_td_errors():
+    from sb3_gqn.targets import critic_ensemble_loss
+
+    currents = [th.tensor([0.0, 0.0]), th.tensor([1.0, 0.0])]
+    targets = [th.tensor([0.5, 3.0]), th.tensor([1.0, 1.0])]
+    # Huber (delta 1): critic 1: 0.5 * 0.5^2 = 0.125 and 3 - 0.5 = 2.5 -> mean 1.3125; critic 2: 0 and 0.5 -> 0.25
+    loss, abs_td_errors = critic_ensemble_loss(currents, targets)
+    assert loss.item() == pytest.approx(1.3125 + 0.25)
+    np.testing.assert_allclose(abs_td_errors.numpy(), [(0.5 + 0.0) / 2, (3.0 + 1.0) / 2])
+    weights = th.tensor([1.0, 0.5])  # (0.125 + 1.25) / 2 + (0 + 0.25) / 2
+    assert critic_ensemble_loss(currents, targets, weights)[0].item() == pytest.approx(0.6875 + 0.125)

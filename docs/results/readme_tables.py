@@ -98,6 +98,37 @@ def probes() -> str:
     return "\n\n".join([sections["final"].body, "**Mean over seeds**", sections["means"].body])
 
 
+#: DecQN's residual torso (``policy_kwargs=dict(residual_layer_norm=True)``) in place of each task's shipped torso, at
+#: the task's shipped update ratio: the runner's variant per task
+RESIDUAL_VARIANTS = {
+    "dm_control/cartpole-swingup-v0": "gqn-adaptive+residual",
+    "dm_control/finger-spin-v0": "gqn-adaptive+residual+1update",
+    "dm_control/walker-walk-v0": "gqn-adaptive+residual+1update",
+}
+
+
+def residual_torso() -> str:
+    """gqn-adaptive with DecQN's residual torso against the shipped entry on the seeds both ran (issue 11, item 5)."""
+    table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
+    parts = []
+    for env, variant in RESIDUAL_VARIANTS.items():
+        residual = table[(table["env"] == env) & (table["algo"] == variant)]
+        seeds = sorted(residual["seed"].unique())
+        shipped_runs = table[(table["env"] == env) & (table["algo"] == "gqn-adaptive") & table["seed"].isin(seeds)]
+        parts.append(residual.assign(algo="gqn-adaptive, residual torso"))
+        parts.append(shipped_runs.assign(algo="gqn-adaptive, shipped torso"))
+    sections = report_sections(pd.concat(parts, ignore_index=True), reps=100)
+    return "\n\n".join(
+        [
+            sections["final"].body,
+            "**Mean over seeds**",
+            sections["means"].body,
+            f"**{sections['growth'].heading}**",
+            sections["growth"].body,
+        ]
+    )
+
+
 def final_policies() -> str:
     """The final greedy policies bin by bin (``docs/results/final_policies.csv``, written by ``final_policies.py``
     from the runs' saved models, which are not committed)."""
@@ -152,6 +183,7 @@ def bin_interpolation() -> str:
 BLOCKS: dict[str, Callable[[], str]] = {
     "issue-11-main": main_comparison,
     "issue-11-probes": probes,
+    "issue-11-residual-torso": residual_torso,
     "issue-11-final-policies": final_policies,
     "issue-11-bin-interpolation": bin_interpolation,
 }

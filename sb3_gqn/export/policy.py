@@ -62,10 +62,10 @@ class DeployedPolicy(nn.Module):
     """A trained GQN's greedy policy as one module: ``observation -> env action`` for a batch.
 
     observation -> ``VecNormalize`` statistics (optional) -> SB3's preprocessing (float, image scaling by 1/255,
-    one-hot for discrete parts, flattening, via the network's own features extractor) -> torso -> head ->
-    argmax over the active bins (paper eq. 3, the mask baked in) -> each bin's env value (``Box``: the bin grid
-    ``linspace(low, high, max_bins)`` per dimension, reshaped to the action space's shape; ``Discrete``: the index;
-    ``MultiDiscrete``: the indices).
+    one-hot for discrete parts, flattening, via the network's own features extractor) -> torso -> head (with
+    several critics: their element-wise maximum) -> argmax over the active bins (paper eq. 3, the mask baked in)
+    -> each bin's env value (``Box``: the bin grid ``linspace(low, high, max_bins)`` per dimension, reshaped to the
+    action space's shape; ``Discrete``: the index; ``MultiDiscrete``: the indices).
 
     A copy on the CPU, in evaluation mode: later training of ``model`` does not change it. Observations are
     batched (first dimension) and laid out as the policy sees them (images channel-first, as SB3's
@@ -81,7 +81,9 @@ class DeployedPolicy(nn.Module):
         self.observation_space = policy.observation_space
         self.action_space = model.action_space  # the env's own space (Box, Discrete or MultiDiscrete)
         self.q_net: DecoupledQNetwork = copy.deepcopy(policy.q_net).cpu().eval()
-        for parameter in self.q_net.parameters():
+        # With n_critics > 1 the greedy action maximizes the critics' element-wise maximum, as in training
+        self.extra_q_nets = nn.ModuleList(copy.deepcopy(critic).cpu().eval() for critic in policy.extra_q_nets)
+        for parameter in self.parameters():
             parameter.requires_grad_(False)
         self.normalizer = ObservationNormalizer(vec_normalize) if vec_normalize is not None else None
         self.register_buffer("active_bins_mask", policy.active_bins_mask.detach().cpu().clone())
@@ -97,7 +99,10 @@ class DeployedPolicy(nn.Module):
     def forward(self, observation: Observation) -> th.Tensor:
         if self.normalizer is not None:
             observation = self.normalizer(observation)
-        bins = masked_argmax(self.q_net(observation), self.active_bins_mask)  # (batch, action_dims)
+        utilities = self.q_net(observation)
+        for critic in self.extra_q_nets:
+            utilities = th.maximum(utilities, critic(observation))
+        bins = masked_argmax(utilities, self.active_bins_mask)  # (batch, action_dims)
         if self.continuous:
             values = self.bin_values.expand(bins.shape[0], -1, -1).gather(2, bins.unsqueeze(-1)).squeeze(-1)
             return values.reshape((-1, *self.action_shape))

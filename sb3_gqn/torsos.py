@@ -1,0 +1,111 @@
+"""Feature torsos of the decoupled critic: the MLP variants and DecQN's residual torso as its reference runs it."""
+
+from __future__ import annotations
+
+import math
+
+import torch as th
+from torch import nn
+
+
+def variance_scaling_uniform_(linear: nn.Linear, scale: float = 1.0 / 3.0) -> nn.Linear:
+    """Sonnet's ``VarianceScaling(scale, mode="fan_out", distribution="uniform")`` for the weights, zero biases.
+
+    The weights are drawn from ``U(-b, b)`` with ``b = sqrt(3 * scale / fan_out)``: with DecQN's ``scale = 1/3``,
+    ``b = 1 / sqrt(fan_out)``. DecQN's reference initializes every layer of its residual torso and its head so (its
+    ``uniform_initializer``; Sonnet's biases start at zero). PyTorch's default draws ``b = 1 / sqrt(fan_in)`` for
+    both weights and biases.
+    """
+    bound = math.sqrt(3.0 * scale / linear.out_features)
+    with th.no_grad():
+        linear.weight.uniform_(-bound, bound)
+        if linear.bias is not None:
+            linear.bias.zero_()
+    return linear
+
+
+class DecoupledMLP(nn.Module):
+    """MLP torso of the decoupled critic.
+
+    Plain: ``Linear -> activation`` per hidden layer. With ``layer_norm`` it is DecQN's default torso (Acme's
+    ``LayerNormMLP``): the first layer is ``Linear -> LayerNorm -> tanh``, which keeps the features of
+    unnormalized observations in a fixed range, and the others ``Linear -> activation``. With
+    ``residual``, blocks whose input and output sizes match add their input to their output.
+
+    :param input_dim: features dimension
+    :param net_arch: hidden layer sizes
+    :param activation_fn: activation class of the hidden layers (after the first one with ``layer_norm``)
+    :param layer_norm: LayerNorm and tanh after the first layer
+    :param residual: residual connections between equal-size hidden blocks
+    """
+
+    def __init__(
+        self,
+        input_dim: int,
+        net_arch: list[int],
+        activation_fn: type[nn.Module] = nn.ReLU,
+        layer_norm: bool = False,
+        residual: bool = False,
+    ):
+        super().__init__()
+        self.blocks = nn.ModuleList()
+        self.skips: list[bool] = []
+        last_dim = input_dim
+        for index, size in enumerate(net_arch):
+            if layer_norm and index == 0:
+                block = nn.Sequential(nn.Linear(last_dim, size), nn.LayerNorm(size), nn.Tanh())
+            else:
+                block = nn.Sequential(nn.Linear(last_dim, size), activation_fn())
+            self.blocks.append(block)
+            self.skips.append(residual and size == last_dim)
+            last_dim = size
+        self.output_dim = last_dim
+
+    def forward(self, features: th.Tensor) -> th.Tensor:
+        hidden = features
+        for block, skip in zip(self.blocks, self.skips, strict=True):
+            output = hidden
+            # Each layer's ``forward`` directly: at batch 1 the module-call machinery (hook dispatch) costs about as
+            # much as the matmuls themselves (sb3-gqn adds no hooks; ``register_forward_hook`` on layers is not run).
+            for layer in block:
+                output = layer.forward(output)
+            hidden = hidden + output if skip else output
+        return hidden
+
+
+class ResidualLayerNormMLP(nn.Module):
+    """DecQN's residual torso as its reference experiments run it (``use_residual=True``).
+
+    Acme's ``LayerNormAndResidualMLP`` followed by ELU: ``x = Linear(input, h)``, then per block
+    ``x = LayerNorm(x + Linear(relu(Linear(x))))``, then ``elu(x)``. ``net_arch = [h] * (1 + blocks)``: the first
+    entry is the width, each further entry one residual block of two ``h x h`` layers (DecQN's ``[512, 512]`` is one
+    block, as in its reference). Every linear layer is initialized with :func:`variance_scaling_uniform_`.
+
+    :param input_dim: features dimension
+    :param net_arch: hidden sizes, all equal, at least two entries
+    """
+
+    def __init__(self, input_dim: int, net_arch: list[int]):
+        super().__init__()
+        if len(net_arch) < 2 or len(set(net_arch)) != 1:
+            raise ValueError(
+                f"The residual torso needs net_arch = [width] * (1 + residual blocks) with at least one block, got {net_arch}"
+            )
+        width = net_arch[0]
+        self.input_layer = variance_scaling_uniform_(nn.Linear(input_dim, width))
+        self.blocks = nn.ModuleList(
+            nn.Sequential(
+                variance_scaling_uniform_(nn.Linear(width, width)),
+                nn.ReLU(),
+                variance_scaling_uniform_(nn.Linear(width, width)),
+            )
+            for _ in net_arch[1:]
+        )
+        self.norms = nn.ModuleList(nn.LayerNorm(width) for _ in net_arch[1:])
+        self.output_dim = width
+
+    def forward(self, features: th.Tensor) -> th.Tensor:
+        hidden = self.input_layer(features)
+        for block, norm in zip(self.blocks, self.norms, strict=True):
+            hidden = norm(hidden + block(hidden))
+        return nn.functional.elu(hidden)
