@@ -283,6 +283,8 @@ class GQNPolicy(BasePolicy):
         """The utilities greedy actions maximize: the online critic's, or with several critics their element-wise
         maximum (DecQN's reference acts on ``max(Q1, Q2)``); ``(batch, action_dims, max_bins)``."""
         utilities = self.q_net.forward(obs)
+        if self.n_critics == 1:  # the acting path: no ModuleList walk per env step
+            return utilities
         for critic in self.extra_q_nets:
             utilities = th.maximum(utilities, critic.forward(obs))
         return utilities

@@ -99,24 +99,27 @@ def probes() -> str:
 
 
 #: DecQN's residual torso (``policy_kwargs=dict(residual_layer_norm=True)``) in place of each task's shipped torso, at
-#: the task's shipped update ratio: the runner's variant per task
-RESIDUAL_VARIANTS = {
-    "dm_control/cartpole-swingup-v0": "gqn-adaptive+residual",
-    "dm_control/finger-spin-v0": "gqn-adaptive+residual+1update",
-    "dm_control/walker-walk-v0": "gqn-adaptive+residual+1update",
+#: the task's shipped update ratio: the runner's variant suffix per task
+RESIDUAL_SUFFIXES = {
+    "dm_control/cartpole-swingup-v0": "+residual",
+    "dm_control/finger-spin-v0": "+residual+1update",
+    "dm_control/walker-walk-v0": "+residual+1update",
 }
 
 
 def residual_torso() -> str:
-    """gqn-adaptive with DecQN's residual torso against the shipped entry on the seeds both ran (issue 11, item 5)."""
+    """The agents run with DecQN's residual torso against their shipped entries on the same seeds (issue 11, item 5)."""
     table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
     parts = []
-    for env, variant in RESIDUAL_VARIANTS.items():
-        residual = table[(table["env"] == env) & (table["algo"] == variant)]
-        seeds = sorted(residual["seed"].unique())
-        shipped_runs = table[(table["env"] == env) & (table["algo"] == "gqn-adaptive") & table["seed"].isin(seeds)]
-        parts.append(residual.assign(algo="gqn-adaptive, residual torso"))
-        parts.append(shipped_runs.assign(algo="gqn-adaptive, shipped torso"))
+    for env, suffix in RESIDUAL_SUFFIXES.items():
+        for agent in MAIN_ALGOS:
+            residual = table[(table["env"] == env) & (table["algo"] == agent + suffix)]
+            if residual.empty:
+                continue
+            seeds = sorted(residual["seed"].unique())
+            same_seeds = table[(table["env"] == env) & (table["algo"] == agent) & table["seed"].isin(seeds)]
+            parts.append(residual.assign(algo=f"{agent}, residual torso"))
+            parts.append(same_seeds.assign(algo=f"{agent}, shipped torso"))
     sections = report_sections(pd.concat(parts, ignore_index=True), reps=100)
     return "\n\n".join(
         [
