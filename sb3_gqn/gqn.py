@@ -509,7 +509,7 @@ class GQN(OffPolicyAlgorithm):
             self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)
 
         critics = self.policy.critics
-        online_parameters = [parameter for online, _ in critics for parameter in online.parameters()]
+        online_parameters = self.policy.online_parameters()
         losses, q_values = [], []
         for _ in range(gradient_steps):
             replay_data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -22,7 +22,15 @@ from torch import nn
 from sb3_gqn.masking import masked_argmax
 from sb3_gqn.torsos import DecoupledMLP, ResidualLayerNormMLP, variance_scaling_uniform_
 
-__all__ = ["CnnPolicy", "DecoupledMLP", "DecoupledQNetwork", "GQNPolicy", "MlpPolicy", "MultiInputPolicy"]
+__all__ = [
+    "CnnPolicy",
+    "DecoupledMLP",
+    "DecoupledQNetwork",
+    "GQNPolicy",
+    "MlpPolicy",
+    "MultiInputPolicy",
+    "critics_maximum",
+]
 
 # Layers whose output depends on ``module.training`` (SB3's own policies switch modes for these).
 _MODE_DEPENDENT_LAYERS = (nn.modules.dropout._DropoutNd, nn.modules.batchnorm._NormBase)
@@ -62,6 +70,15 @@ def check_residual_layer_norm_options(layer_norm: bool, residual: bool, activati
             "residual_layer_norm=True fixes its activations (ReLU inside each block, ELU after the torso): "
             f"leave activation_fn at its default, got {activation_fn.__name__}"
         )
+
+
+def critics_maximum(first: DecoupledQNetwork, others: Iterable[nn.Module], obs: PyTorchObs) -> th.Tensor:
+    """Element-wise maximum of the critics' utilities ``(batch, action_dims, max_bins)``: what greedy actions maximize
+    with several critics (DecQN's reference acts on ``max(Q1, Q2)``), in training and in the exported policy."""
+    utilities = first.forward(obs)
+    for critic in others:
+        utilities = th.maximum(utilities, critic.forward(obs))
+    return utilities
 
 
 class DecoupledQNetwork(BasePolicy):
@@ -236,9 +253,7 @@ class GQNPolicy(BasePolicy):
         self.activation_fn = activation_fn
         self.layer_norm = layer_norm
         self.residual = residual
-        self.residual_layer_norm = residual_layer_norm
-        if residual_layer_norm:
-            check_residual_layer_norm_options(layer_norm, residual, activation_fn)
+        self.residual_layer_norm = residual_layer_norm  # its option errors come from DecoupledQNetwork in _build
         if not isinstance(n_critics, int) or n_critics < 1:
             raise ValueError(f"n_critics must be a positive integer, got {n_critics!r}")
         self.n_critics = n_critics
@@ -269,7 +284,7 @@ class GQNPolicy(BasePolicy):
         self._mode_dependent = any(isinstance(module, _MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
         # Only the online networks are optimized (the target nets' parameters stay out of the optimizer)
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
-            [parameter for online, _ in self.critics for parameter in online.parameters()],
+            self.online_parameters(),
             lr=lr_schedule(1),
             **self.optimizer_kwargs,
         )
@@ -279,15 +294,16 @@ class GQNPolicy(BasePolicy):
         """``(online, target)`` network of every critic, the first one's (``q_net``, ``q_net_target``) first."""
         return [(self.q_net, self.q_net_target), *zip(self.extra_q_nets, self.extra_q_nets_target, strict=True)]  # type: ignore[list-item]
 
+    def online_parameters(self) -> list[nn.Parameter]:
+        """The parameters of every critic's online network: what the optimizer updates and gradient clipping bounds."""
+        return [parameter for online, _ in self.critics for parameter in online.parameters()]
+
     def greedy_utilities(self, obs: PyTorchObs) -> th.Tensor:
         """The utilities greedy actions maximize: the online critic's, or with several critics their element-wise
         maximum (DecQN's reference acts on ``max(Q1, Q2)``); ``(batch, action_dims, max_bins)``."""
-        utilities = self.q_net.forward(obs)
         if self.n_critics == 1:  # the acting path: no ModuleList walk per env step
-            return utilities
-        for critic in self.extra_q_nets:
-            utilities = th.maximum(utilities, critic.forward(obs))
-        return utilities
+            return self.q_net.forward(obs)
+        return critics_maximum(self.q_net, self.extra_q_nets, obs)
 
     def make_q_net(self) -> DecoupledQNetwork:
         # Make sure we always have separate networks for features extractors etc

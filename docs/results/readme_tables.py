@@ -109,7 +109,7 @@ RESIDUAL_SUFFIXES = {
 TWIN_SUFFIXES = {"dm_control/cartpole-swingup-v0": "+twin"}
 
 
-def residual_torso() -> str:
+def item_5_probes() -> str:
     """The agents run with DecQN's residual torso or two critics against their shipped entries on the same seeds
     (issue 11, item 5)."""
     table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
@@ -191,7 +191,7 @@ def bin_interpolation() -> str:
 BLOCKS: dict[str, Callable[[], str]] = {
     "issue-11-main": main_comparison,
     "issue-11-probes": probes,
-    "issue-11-residual-torso": residual_torso,
+    "issue-11-item-5": item_5_probes,
     "issue-11-final-policies": final_policies,
     "issue-11-bin-interpolation": bin_interpolation,
 }

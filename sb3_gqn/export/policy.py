@@ -12,7 +12,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from torch import nn
 
 from sb3_gqn.masking import masked_argmax
-from sb3_gqn.policies import DecoupledQNetwork
+from sb3_gqn.policies import DecoupledQNetwork, critics_maximum
 
 if TYPE_CHECKING:
     from sb3_gqn.gqn import GQN
@@ -99,9 +99,7 @@ class DeployedPolicy(nn.Module):
     def forward(self, observation: Observation) -> th.Tensor:
         if self.normalizer is not None:
             observation = self.normalizer(observation)
-        utilities = self.q_net(observation)
-        for critic in self.extra_q_nets:
-            utilities = th.maximum(utilities, critic(observation))
+        utilities = critics_maximum(self.q_net, self.extra_q_nets, observation)
         bins = masked_argmax(utilities, self.active_bins_mask)  # (batch, action_dims)
         if self.continuous:
             values = self.bin_values.expand(bins.shape[0], -1, -1).gather(2, bins.unsqueeze(-1)).squeeze(-1)
