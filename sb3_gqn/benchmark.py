@@ -86,6 +86,8 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "gqn-adaptive+residual+1update": ("gqn", {"growth": "adaptive", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     "decqn-9+residual": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 2}),
     "decqn-9+residual+1update": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
+    "gqn-linear+residual+1update": ("gqn", {"growth": "linear", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
+    "decqn-2+residual+1update": ("decqn", {"bins": 2, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive", "policy_kwargs": "dict(n_critics=2)"}),
 }

@@ -218,6 +218,27 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update
         }
 
 
+def test_the_residual_1update_variants_are_the_walker_entries_with_only_the_torso_swapped():
+    """The candidate for walker's entry (issue 11 item 5): each of the four agents' ``+residual+1update`` variant
+    trains walker's shipped entry with DecQN's residual torso and nothing else changed, so its runs compare with
+    the shipped ones seed for seed."""
+    from sb3_gqn.benchmark import RESIDUAL_TORSO, _shipped_entry, run_overrides
+
+    walker = "dm_control/walker-walk-v0"
+    for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
+        trained = {}
+        for name in (algo, f"{algo}+residual+1update"):
+            zoo_algo, overrides = run_overrides(RunSpec(name, walker, 0.1, 0, 1000))
+            trained[name] = {**_shipped_entry(zoo_algo, walker), **overrides}
+        changed = {
+            key
+            for key in trained[algo] | trained[f"{algo}+residual+1update"]
+            if trained[algo].get(key) != trained[f"{algo}+residual+1update"].get(key)
+        }
+        assert changed == {"policy_kwargs"}
+        assert trained[f"{algo}+residual+1update"]["policy_kwargs"] == RESIDUAL_TORSO
+
+
 @pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])
 def test_help_texts_are_plain_text(module, capsys):
     entry_point = importlib.import_module(module).main
