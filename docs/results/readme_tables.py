@@ -113,7 +113,7 @@ def item_5_probes() -> str:
     """The agents run with DecQN's residual torso or two critics against their shipped entries on the same seeds
     (issue 11, item 5)."""
     table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
-    parts = []
+    parts, pairs = [], []
     for suffixes, label in [(RESIDUAL_SUFFIXES, "residual torso"), (TWIN_SUFFIXES, "two critics")]:
         for env, suffix in suffixes.items():
             for agent in MAIN_ALGOS:
@@ -124,8 +124,16 @@ def item_5_probes() -> str:
                 same_seeds = table[(table["env"] == env) & (table["algo"] == agent) & table["seed"].isin(seeds)]
                 parts.append(probe.assign(algo=f"{agent}, {label}"))
                 parts.append(same_seeds.assign(algo=f"{agent}, shipped entry"))
+                if (f"{agent}, {label}", f"{agent}, shipped entry") not in pairs:
+                    pairs.append((f"{agent}, {label}", f"{agent}, shipped entry"))
     # a task's shipped runs appear once even when two probes compare with them
-    sections = report_sections(pd.concat(parts, ignore_index=True).drop_duplicates(), reps=100)
+    probes_and_shipped = pd.concat(parts, ignore_index=True).drop_duplicates()
+    sections = report_sections(probes_and_shipped, reps=100)
+    # the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run where SAC ran (walker)
+    pairs += [("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")]
+    with_sac = pd.concat([probes_and_shipped, table[table["algo"] == "sac"]], ignore_index=True)
+    comparisons = comparisons_per_task(with_sac, pairs, reps=2000)
+    assert comparisons is not None, "every probe has its shipped entry's runs on the same seeds"
     return "\n\n".join(
         [
             sections["final"].body,
@@ -133,6 +141,8 @@ def item_5_probes() -> str:
             sections["means"].body,
             f"**{sections['growth'].heading}**",
             sections["growth"].body,
+            f"**{comparisons.heading}**; the shipped entry on the probe's seeds, SAC on all of its seeds",
+            comparisons.body,
         ]
     )
 
