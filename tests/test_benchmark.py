@@ -188,16 +188,20 @@ def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
         )
 
 
+def trained(algo: str, env: str) -> dict:
+    """The hyperparameters the runner trains ``algo`` with on ``env``: the shipped entry with the variant's overrides."""
+    from sb3_gqn.benchmark import _shipped_entry, run_overrides
+
+    zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
+    return {**_shipped_entry(zoo_algo, env), **overrides}
+
+
 def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update_variants():
     """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train."""
-    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, _shipped_entry, run_overrides
+    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, run_overrides
 
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
-
-    def trained(algo: str, env: str) -> dict:
-        zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
-        return {**_shipped_entry(zoo_algo, env), **overrides}
 
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         for env in (walker, finger):
@@ -222,21 +226,13 @@ def test_the_residual_1update_variants_are_the_walker_entries_with_only_the_tors
     """The candidate for walker's entry (issue 11 item 5): each of the four agents' ``+residual+1update`` variant
     trains walker's shipped entry with DecQN's residual torso and nothing else changed, so its runs compare with
     the shipped ones seed for seed."""
-    from sb3_gqn.benchmark import RESIDUAL_TORSO, _shipped_entry, run_overrides
+    from sb3_gqn.benchmark import RESIDUAL_TORSO
 
     walker = "dm_control/walker-walk-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
-        trained = {}
-        for name in (algo, f"{algo}+residual+1update"):
-            zoo_algo, overrides = run_overrides(RunSpec(name, walker, 0.1, 0, 1000))
-            trained[name] = {**_shipped_entry(zoo_algo, walker), **overrides}
-        changed = {
-            key
-            for key in trained[algo] | trained[f"{algo}+residual+1update"]
-            if trained[algo].get(key) != trained[f"{algo}+residual+1update"].get(key)
-        }
-        assert changed == {"policy_kwargs"}
-        assert trained[f"{algo}+residual+1update"]["policy_kwargs"] == RESIDUAL_TORSO
+        shipped, candidate = trained(algo, walker), trained(f"{algo}+residual+1update", walker)
+        assert {key for key in shipped | candidate if shipped.get(key) != candidate.get(key)} == {"policy_kwargs"}
+        assert candidate["policy_kwargs"] == RESIDUAL_TORSO
 
 
 @pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])
