@@ -20,6 +20,7 @@ range (max - min over the 9 bins) of the same states so that tasks compare. Rows
 
     .venv/bin/python docs/results/bin_interpolation.py
     .venv/bin/python docs/results/bin_interpolation.py --tables walker-walk_c0.1_100k_torso
+    .venv/bin/python docs/results/bin_interpolation.py --algos gqn-linear+residual+1update --only-new   # added runs
 """
 
 from __future__ import annotations
@@ -136,9 +137,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
+    parser.add_argument("--only-new", action="store_true", help="skip the runs that already have rows in the CSV")
     args = parser.parse_args(argv)
     rows = {(row["table"], row["algo"], row["env"], row["seed"], row["growth_step"]): row for row in _read(OUT)}
+    done = {key[:4] for key in rows}
     for run_dir, spec in finished_runs(args.tables, args.algos):
+        if args.only_new and (run_dir.parent.parent.name, spec.algo, spec.env, str(spec.seed)) in done:
+            continue
         for row in probe(run_dir, spec):
             rows[tuple(str(row[key]) for key in COLUMNS[:5])] = row
             print(

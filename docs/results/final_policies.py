@@ -12,6 +12,7 @@ the CSV into the README's table.
 
     .venv/bin/python docs/results/final_policies.py                    # the runs of the README's comparison
     .venv/bin/python docs/results/final_policies.py --algos gqn-adaptive decqn-9 --tables finger-spin_c0.1_100k
+    .venv/bin/python docs/results/final_policies.py --algos decqn-9+residual+1update --only-new   # added runs only
 """
 
 from __future__ import annotations
@@ -96,9 +97,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9", "sac"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
+    parser.add_argument("--only-new", action="store_true", help="skip the runs that already have rows in the CSV")
     args = parser.parse_args(argv)
     rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
     for run_dir, spec in finished_runs(args.tables, args.algos):
+        if args.only_new and (run_dir.parent.parent.name, spec.algo, spec.env, str(spec.seed)) in rows:
+            continue
         row = probe(run_dir, spec)
         rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
         sm, extremes = float(row["smoothness"]), float(row["extreme_share"])
@@ -111,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
 def finished_runs(table_names: list[str] | None, algos: list[str]) -> list[tuple[Path, RunSpec]]:
     """The runs (folder and spec) of the named result folders (default: every ``docs/results/*/results.csv``)
     that finished and kept their ``model.zip``, for the listed algorithms (``gqn-adaptive`` covers its
-    ``+...`` variants)."""
+    ``+...`` variants; a variant's full name, e.g. ``gqn-adaptive+residual+1update``, only itself)."""
     every_table = sorted(path.parent for path in RESULTS.glob("*/results.csv"))
     tables = [RESULTS / name for name in table_names] if table_names else every_table
     runs = [
@@ -120,7 +124,7 @@ def finished_runs(table_names: list[str] | None, algos: list[str]) -> list[tuple
         for run_dir in sorted((table / "runs").glob("*"))
         if (run_dir / "model.zip").is_file() and (run_dir / "done.json").is_file()
     ]
-    return [(run_dir, spec) for run_dir, spec in runs if spec.algo.split("+")[0] in algos]
+    return [(run_dir, spec) for run_dir, spec in runs if spec.algo in algos or spec.algo.split("+")[0] in algos]
 
 
 def _write(path: Path, rows: dict[tuple[str, ...], dict[str, float | str]], columns: list[str]) -> None:
