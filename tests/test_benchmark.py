@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import csv
 import importlib
+import importlib.util
 import json
 import re
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -196,6 +198,14 @@ def trained(algo: str, env: str) -> dict:
     return {**_shipped_entry(zoo_algo, env), **overrides}
 
 
+def readme_tables():
+    """docs/results/readme_tables.py (a script, not a module of the package)."""
+    spec = importlib.util.spec_from_file_location("readme_tables", Path(__file__).parents[1] / "docs/results/readme_tables.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update_variants():
     """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train."""
@@ -203,6 +213,7 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update
 
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
+    assert {walker: "+layernorm+1update", finger: "+layernorm+1update"} == readme_tables().SHIPPED
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         for env in (walker, finger):
             assert trained(algo, env) == trained(f"{algo}+layernorm+1update", env)
@@ -233,6 +244,29 @@ def test_the_residual_1update_variants_are_the_walker_entries_with_only_the_tors
         shipped, candidate = trained(algo, walker), trained(f"{algo}+residual+1update", walker)
         assert {key for key in shipped | candidate if shipped.get(key) != candidate.get(key)} == {"policy_kwargs"}
         assert candidate["policy_kwargs"] == RESIDUAL_TORSO
+
+
+def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_compare_probes_with_the_entry_before():
+    """A task's shipped variant must have run on every seed an earlier entry ran, for every agent of the main
+    comparison: otherwise the first entry's runs would stay in the tables under the plain name, mixed with the shipped
+    ones, or the tables would lose seeds. A probe is compared with the task's shipped entry, or with the entry before
+    it when it is the shipped one."""
+    import pandas as pd
+
+    tables = readme_tables()
+    walker, cartpole = "dm_control/walker-walk-v0", "dm_control/cartpole-swingup-v0"
+    suffix = tables.SHIPPED[walker]
+    runs = [(agent, seed) for agent in tables.MAIN_ALGOS for seed in (0, 1)]
+    first_entry = pd.DataFrame([{"algo": agent, "env": walker, "seed": seed, "return": 1.0} for agent, seed in runs])
+    shipped = pd.DataFrame([{"algo": agent + suffix, "env": walker, "seed": seed, "return": 2.0} for agent, seed in runs])
+    table = tables.shipped(pd.concat([first_entry, shipped], ignore_index=True))
+    assert sorted(table["algo"]) == sorted(agent for agent, _ in runs) and set(table["return"]) == {2.0}
+    with pytest.raises(SystemExit, match=re.escape(f"decqn-9{suffix} (the shipped entry) lacks seeds [1]")):
+        tables.shipped(pd.concat([first_entry, shipped.iloc[:-1]], ignore_index=True))
+
+    assert tables.entry_before(walker, "+residual+1update") == "+layernorm+1update"
+    assert tables.entry_before(walker, "+layernorm+1update") == ""  # a probe that is the shipped entry: the one before
+    assert tables.entry_before(cartpole, "+residual") == ""
 
 
 @pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])

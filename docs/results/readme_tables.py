@@ -19,9 +19,14 @@ from sb3_gqn.report import as_shipped, comparisons_across_tasks, comparisons_per
 
 RESULTS = Path("docs/results")
 README = Path("README.md")
-#: walker-walk's and finger-spin's shipped entries (gqn.yml, decqn.yml) are the runner's ``+layernorm+1update``
-#: variants
-SHIPPED = {"dm_control/walker-walk-v0": "+layernorm+1update", "dm_control/finger-spin-v0": "+layernorm+1update"}
+#: The entries (gqn.yml, decqn.yml) a task has shipped, oldest first, each as the runner's variant suffix that trains
+#: exactly it ("" = the plain names: the entry before issue 11); the last is the shipped one. Tasks not listed have
+#: shipped one entry, the plain names'.
+ENTRIES = {
+    "dm_control/walker-walk-v0": ["", "+layernorm+1update"],
+    "dm_control/finger-spin-v0": ["", "+layernorm+1update"],
+}
+SHIPPED = {env: entries[-1] for env, entries in ENTRIES.items()}
 MAIN_ALGOS = ["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"]
 BASELINES = ["sac"]
 PROBES = [
@@ -44,10 +49,31 @@ MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-wa
 
 
 def shipped(table: pd.DataFrame) -> pd.DataFrame:
-    """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs."""
-    for env, suffix in SHIPPED.items():
-        table = as_shipped(table, env, suffix)
+    """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs.
+
+    Every agent of the main comparison must have run the shipped variant on every seed it ran with an earlier entry:
+    a missing one would otherwise leave the first entry's runs under the plain name, mixed with the shipped ones, or
+    shrink the tables' seeds without a word.
+    """
+    for env, entries in ENTRIES.items():
+        seeds = table[table["env"] == env].groupby("algo")["seed"].agg(set)
+        for agent in MAIN_ALGOS:
+            earlier = set().union(*(seeds.get(agent + suffix, set()) for suffix in entries[:-1]))
+            missing = earlier - seeds.get(agent + entries[-1], set())
+            if missing:
+                raise SystemExit(
+                    f"{env}: {agent + entries[-1]} (the shipped entry) lacks seeds {sorted(missing)} that {agent} ran "
+                    "with an earlier entry; run them before rebuilding the tables"
+                )
+        table = as_shipped(table, env, entries[-1])
     return table
+
+
+def earlier_entries(table: pd.DataFrame) -> pd.Series:
+    """Which rows of ``table`` (runner names) are runs of an agent of the main comparison on an entry its task no
+    longer ships."""
+    names = {(env, agent + suffix) for env, entries in ENTRIES.items() for suffix in entries[:-1] for agent in MAIN_ALGOS}
+    return pd.Series([(env, algo) in names for env, algo in zip(table["env"], table["algo"])], index=table.index)
 
 
 def main_comparison() -> str:
@@ -85,15 +111,15 @@ def main_comparison() -> str:
 
 
 def probes() -> str:
-    """The ablation and probe runs, SAC, on the tasks of ``SHIPPED`` the runs of the entries shipped before (the
-    runs of the shipped entries are in the main comparison, under the plain names), and SHIPPED's variants
-    tried on the other tasks."""
+    """The ablation and probe runs, SAC, the runs of the entries that ENTRIES' tasks shipped before (the runs of the
+    shipped entries are in the main comparison, under the plain names), and those entries tried on other tasks."""
     table = load(sorted(RESULTS.glob("*/results.csv")))
-    earlier = table["env"].isin(list(SHIPPED)) & table["algo"].isin(MAIN_ALGOS)
+    earlier = earlier_entries(table)
     table.loc[earlier, "algo"] = table.loc[earlier, "algo"] + " (earlier entry)"
-    # walker's shipped configuration tried on tasks that do not ship it (not on SHIPPED's: those runs are the main ones)
-    elsewhere = ~table["env"].isin(list(SHIPPED)) & table["algo"].str.endswith(tuple(SHIPPED.values()))
-    table = table[table["algo"].isin([*PROBES, *BASELINES]) | table["algo"].str.endswith("(earlier entry)") | elsewhere]
+    # walker's and finger's entries tried on tasks that never shipped them (cartpole's +layernorm+1update runs)
+    entry_variants = {agent + suffix for entries in ENTRIES.values() for suffix in entries if suffix for agent in MAIN_ALGOS}
+    elsewhere = ~table["env"].isin(list(ENTRIES)) & table["algo"].isin(entry_variants)
+    table = table[table["algo"].isin([*PROBES, *BASELINES]) | earlier | elsewhere]
     sections = report_sections(table, reps=100)
     return "\n\n".join([sections["final"].body, "**Mean over seeds**", sections["means"].body])
 
@@ -109,31 +135,40 @@ RESIDUAL_SUFFIXES = {
 TWIN_SUFFIXES = {"dm_control/cartpole-swingup-v0": "+twin"}
 
 
+def entry_before(env: str, suffix: str) -> str:
+    """The variant suffix of the entry a probe of ``env`` (``suffix``) is compared with: the task's shipped entry, or
+    the one shipped before it when the probe is the shipped entry."""
+    entries = ENTRIES.get(env, [""])
+    return entries[-2] if entries[-1] == suffix else entries[-1]
+
+
 def item_5_probes() -> str:
-    """The agents run with DecQN's residual torso or two critics against their shipped entries on the same seeds
-    (issue 11, item 5)."""
-    table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
+    """The agents run with DecQN's residual torso or two critics against the entry they change, on the same seeds
+    (issue 11, item 5): the task's shipped entry, or on walker, which ships the residual torso, the entry before."""
+    table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])  # runner names: every entry apart
     parts, pairs = [], []
     for suffixes, label in [(RESIDUAL_SUFFIXES, "residual torso"), (TWIN_SUFFIXES, "two critics")]:
         for env, suffix in suffixes.items():
+            before = entry_before(env, suffix)
+            before_label = "shipped entry" if before == SHIPPED.get(env, "") else "earlier entry"
             for agent in MAIN_ALGOS:
                 probe = table[(table["env"] == env) & (table["algo"] == agent + suffix)]
                 if probe.empty:
                     continue
                 seeds = sorted(probe["seed"].unique())
-                same_seeds = table[(table["env"] == env) & (table["algo"] == agent) & table["seed"].isin(seeds)]
+                same_seeds = table[(table["env"] == env) & (table["algo"] == agent + before) & table["seed"].isin(seeds)]
                 parts.append(probe.assign(algo=f"{agent}, {label}"))
-                parts.append(same_seeds.assign(algo=f"{agent}, shipped entry"))
-                if (f"{agent}, {label}", f"{agent}, shipped entry") not in pairs:
-                    pairs.append((f"{agent}, {label}", f"{agent}, shipped entry"))
-    # a task's shipped runs appear once even when two probes compare with them
-    probes_and_shipped = pd.concat(parts, ignore_index=True).drop_duplicates()
-    sections = report_sections(probes_and_shipped, reps=100)
+                parts.append(same_seeds.assign(algo=f"{agent}, {before_label}"))
+                if (f"{agent}, {label}", f"{agent}, {before_label}") not in pairs:
+                    pairs.append((f"{agent}, {label}", f"{agent}, {before_label}"))
+    # a task's entry runs appear once even when two probes compare with them
+    probes_and_entries = pd.concat(parts, ignore_index=True).drop_duplicates()
+    sections = report_sections(probes_and_entries, reps=100)
     # the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run where SAC ran (walker)
     pairs += [("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")]
-    with_sac = pd.concat([probes_and_shipped, table[table["algo"] == "sac"]], ignore_index=True)
+    with_sac = pd.concat([probes_and_entries, table[table["algo"] == "sac"]], ignore_index=True)
     comparisons = comparisons_per_task(with_sac, pairs, reps=2000)
-    assert comparisons is not None, "every probe has its shipped entry's runs on the same seeds"
+    assert comparisons is not None, "every probe has the runs of the entry it changes on the same seeds"
     return "\n\n".join(
         [
             sections["final"].body,
@@ -141,7 +176,7 @@ def item_5_probes() -> str:
             sections["means"].body,
             f"**{sections['growth'].heading}**",
             sections["growth"].body,
-            f"**{comparisons.heading}**; the shipped entry on the probe's seeds, SAC on all of its seeds",
+            f"**{comparisons.heading}**; the entry it changes on the probe's seeds, SAC on all of its seeds",
             comparisons.body,
         ]
     )
