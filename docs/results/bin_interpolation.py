@@ -31,7 +31,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from final_policies import RESULTS, _read, _write, finished_runs
+from final_policies import RESULTS, _read, _write, finished_runs, run_key
 
 from sb3_gqn.benchmark import RunSpec
 
@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = {(row["table"], row["algo"], row["env"], row["seed"], row["growth_step"]): row for row in _read(OUT)}
     done = {key[:4] for key in rows}
     for run_dir, spec in finished_runs(args.tables, args.algos):
-        if args.only_new and (run_dir.parent.parent.name, spec.algo, spec.env, str(spec.seed)) in done:
+        if args.only_new and run_key(run_dir, spec) in done:
             continue
         for row in probe(run_dir, spec):
             rows[tuple(str(row[key]) for key in COLUMNS[:5])] = row

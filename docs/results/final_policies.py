@@ -101,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
     for run_dir, spec in finished_runs(args.tables, args.algos):
-        if args.only_new and (run_dir.parent.parent.name, spec.algo, spec.env, str(spec.seed)) in rows:
+        if args.only_new and run_key(run_dir, spec) in rows:
             continue
         row = probe(run_dir, spec)
         rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
@@ -125,6 +125,11 @@ def finished_runs(table_names: list[str] | None, algos: list[str]) -> list[tuple
         if (run_dir / "model.zip").is_file() and (run_dir / "done.json").is_file()
     ]
     return [(run_dir, spec) for run_dir, spec in runs if spec.algo in algos or spec.algo.split("+")[0] in algos]
+
+
+def run_key(run_dir: Path, spec: RunSpec) -> tuple[str, str, str, str]:
+    """A run's key in the CSVs these scripts write: its result folder, algorithm, env and seed, as the CSV holds them."""
+    return run_dir.parent.parent.name, spec.algo, spec.env, str(spec.seed)
 
 
 def _write(path: Path, rows: dict[tuple[str, ...], dict[str, float | str]], columns: list[str]) -> None:

@@ -144,7 +144,8 @@ def entry_before(env: str, suffix: str) -> str:
 
 def item_5_probes() -> str:
     """The agents run with DecQN's residual torso or two critics against the entry they change, on the same seeds
-    (issue 11, item 5): the task's shipped entry, or on walker, which ships the residual torso, the entry before."""
+    (issue 11, item 5): the task's shipped entry, or the one shipped before it when the probe is the shipped entry
+    (``entry_before``)."""
     table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])  # runner names: every entry apart
     parts, pairs = [], []
     for suffixes, label in [(RESIDUAL_SUFFIXES, "residual torso"), (TWIN_SUFFIXES, "two critics")]:
