@@ -30,8 +30,7 @@ from torch import nn
 
 from sb3_gqn import GQN
 from sb3_gqn.envs import make_env
-from sb3_gqn.gqn import clip_grad_norm
-from sb3_gqn.targets import decoupled_q_value, double_q_target, huber_td_loss
+from sb3_gqn.targets import clip_grad_norm, decoupled_q_value, double_q_target, huber_td_loss
 
 
 def milliseconds_per_call(function: Callable[[], object], calls: int) -> float:

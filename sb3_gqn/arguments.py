@@ -55,6 +55,13 @@ def check_learning_rate(value: Any) -> float | Callable[[float], float]:
     raise ValueError(f"learning_rate must be a finite number > 0 or a schedule (callable), got {value!r}")
 
 
+def check_choice(name: str, value: Any, choices: Iterable[Any]) -> None:
+    """``value`` must be one of ``choices`` (``None`` can be one); ``ValueError`` naming them otherwise."""
+    choices = tuple(choices)
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {choices}, got {value!r}")
+
+
 def check_train_freq(value: Any) -> None:
     """``train_freq``: an int >= 1, or ``(int >= 1, "step" | "episode")`` as SB3 accepts it."""
     if isinstance(value, (tuple, list)):

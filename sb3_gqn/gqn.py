@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterable
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
@@ -18,7 +17,7 @@ from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedul
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.arguments import check_int, check_learning_rate, check_number, check_replay_sizes, check_train_freq
+from sb3_gqn.arguments import check_choice, check_int, check_learning_rate, check_number, check_replay_sizes, check_train_freq
 from sb3_gqn.buffers import PrioritizedDictReplayBuffer, PrioritizedReplayBuffer, PrioritizedSampling
 from sb3_gqn.envs import check_action_space, resolve_env
 from sb3_gqn.growth import (
@@ -27,40 +26,17 @@ from sb3_gqn.growth import (
     RETURN_SOURCES,
     AdaptiveGrowth,
     GrowthCallback,
+    bin_levels_from,
     interpolation_neighbours,
-    nested_bin_levels,
 )
 from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, active_bin_mask, epsilon_greedy
 from sb3_gqn.nstep_dict import NStepDictReplayBuffer
-from sb3_gqn.policies import CnnPolicy, DecoupledQNetwork, GQNPolicy, MlpPolicy, MultiInputPolicy
-from sb3_gqn.targets import critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
+from sb3_gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
+from sb3_gqn.q_network import DecoupledQNetwork
+from sb3_gqn.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.wrappers import BinGrid
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
-
-
-def clip_grad_norm(parameters: Iterable[th.nn.Parameter], max_norm: float) -> th.Tensor:
-    """``th.nn.utils.clip_grad_norm_`` (2-norm over all gradients), with the same result, minus its cost when there
-    is nothing to clip.
-
-    PyTorch multiplies every gradient by ``min(max_norm / (norm + 1e-6), 1)`` unconditionally, to avoid a device
-    sync; on CPU the comparison is free and the multiplication by 1.0 (with its grouping of the tensors) cost
-    ~0.1 ms of a ~4.5 ms cartpole update. Elsewhere (CUDA) this is ``clip_grad_norm_``. Returns the total norm.
-    """
-    with_grad = [parameter for parameter in parameters if parameter.grad is not None]
-    total_norm = th.nn.utils.get_total_norm([parameter.grad for parameter in with_grad])
-    if total_norm.device.type != "cpu" or not total_norm + 1e-6 <= max_norm:  # NaN norms go on to PyTorch too
-        th.nn.utils.clip_grads_with_norm_(with_grad, max_norm, total_norm)
-    return total_norm
-
-
-def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
-    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`)."""
-    if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
-        return nested_bin_levels(int(bins), int(bins))
-    if isinstance(bins, (tuple, list)) and len(bins) == 2:
-        return nested_bin_levels(bins[0], bins[1])
-    raise TypeError(f"bins must be an int or an (initial, final) pair, got {bins!r}")
 
 
 class GQN(OffPolicyAlgorithm):
@@ -235,14 +211,10 @@ class GQN(OffPolicyAlgorithm):
             check_int("growth_patience", growth_patience, 1)
         check_number("growth_min_improvement", growth_min_improvement, 0.0)
         check_int("stats_window_size", stats_window_size, 1)
-        if growth_returns not in RETURN_SOURCES:
-            raise ValueError(f"growth_returns must be one of {RETURN_SOURCES}, got {growth_returns!r}")
-        if growth not in GROWTH_SCHEDULES:
-            raise ValueError(f"growth must be one of {GROWTH_SCHEDULES}, got {growth!r}")
-        if growth_init not in GROWTH_INITS:
-            raise ValueError(f"growth_init must be one of {GROWTH_INITS}, got {growth_init!r}")
-        if exploration not in EXPLORATION_MODES:
-            raise ValueError(f"exploration must be one of {EXPLORATION_MODES}, got {exploration!r}")
+        check_choice("growth_returns", growth_returns, RETURN_SOURCES)
+        check_choice("growth", growth, GROWTH_SCHEDULES)
+        check_choice("growth_init", growth_init, GROWTH_INITS)
+        check_choice("exploration", exploration, EXPLORATION_MODES)
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
         env = resolve_env(env)  # type: ignore[assignment]

@@ -63,6 +63,15 @@ def nested_bin_levels(initial: int, final: int) -> list[int]:
     return levels
 
 
+def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
+    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`)."""
+    if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
+        return nested_bin_levels(int(bins), int(bins))
+    if isinstance(bins, (tuple, list)) and len(bins) == 2:
+        return nested_bin_levels(bins[0], bins[1])
+    raise TypeError(f"bins must be an int or an (initial, final) pair, got {bins!r}")
+
+
 def adaptive_threshold(mean: float, std: float) -> float:
     """Paper eq. 4: ``(1 - 0.05 sgn(mu)) mu + 0.9 sigma``.
 

@@ -1,6 +1,9 @@
-"""The decoupled, masked double-Q learning target (paper eqs. 1-3) as pure tensor functions."""
+"""The decoupled, masked double-Q learning target (paper eqs. 1-3), its loss and the update's gradient clipping as
+pure tensor functions."""
 
 from __future__ import annotations
+
+from collections.abc import Iterable
 
 import torch as th
 
@@ -112,3 +115,18 @@ def critic_ensemble_loss(
         strict=True,
     )
     return th.stack(losses).sum(), th.stack(abs_td_errors).mean(dim=0)
+
+
+def clip_grad_norm(parameters: Iterable[th.nn.Parameter], max_norm: float) -> th.Tensor:
+    """``th.nn.utils.clip_grad_norm_`` (2-norm over all gradients), with the same result, minus its cost when there
+    is nothing to clip.
+
+    PyTorch multiplies every gradient by ``min(max_norm / (norm + 1e-6), 1)`` unconditionally, to avoid a device
+    sync; on CPU the comparison is free and the multiplication by 1.0 (with its grouping of the tensors) cost
+    ~0.1 ms of a ~4.5 ms cartpole update. Elsewhere (CUDA) this is ``clip_grad_norm_``. Returns the total norm.
+    """
+    with_grad = [parameter for parameter in parameters if parameter.grad is not None]
+    total_norm = th.nn.utils.get_total_norm([parameter.grad for parameter in with_grad])
+    if total_norm.device.type != "cpu" or not total_norm + 1e-6 <= max_norm:  # NaN norms go on to PyTorch too
+        th.nn.utils.clip_grads_with_norm_(with_grad, max_norm, total_norm)
+    return total_norm

@@ -42,6 +42,9 @@ BAD_ARGUMENTS = [
     ("growth_patience", 0, ">= 1"),
     ("growth_min_improvement", -0.05, "[0, inf)"),
     ("growth_returns", "greedy", "('evaluation', 'training')"),
+    ("growth", "exponential", "('adaptive', 'linear', None)"),
+    ("growth_init", "zeros", "('interpolate', 'none')"),
+    ("exploration", "per_joint", "('shared', 'per_dimension')"),
     ("stats_window_size", 0, ">= 1"),
 ]
 

@@ -8,6 +8,8 @@ ALGORITHM_LAYER = [
     "sb3_gqn.gqn",
     "sb3_gqn.decqn",
     "sb3_gqn.policies",
+    "sb3_gqn.q_network",
+    "sb3_gqn.torsos",
     "sb3_gqn.targets",
     "sb3_gqn.masking",
     "sb3_gqn.growth",

@@ -69,7 +69,7 @@ def test_double_q_target_with_sb3_n_step_buffer():
 
 @pytest.mark.parametrize("max_norm", [10.0, 5.0 + 1e-6, 2.5, 0.1])
 def test_clip_grad_norm_by_hand_and_equal_to_pytorch(max_norm):
-    from sb3_gqn.gqn import clip_grad_norm
+    from sb3_gqn.targets import clip_grad_norm
 
     def parameters_with_grads() -> list[th.nn.Parameter]:
         first, second, third = th.nn.Parameter(th.zeros(2)), th.nn.Parameter(th.zeros(1)), th.nn.Parameter(th.zeros(3))
@@ -87,7 +87,7 @@ def test_clip_grad_norm_by_hand_and_equal_to_pytorch(max_norm):
 
 
 def test_clip_grad_norm_passes_a_nan_norm_on_like_pytorch():
-    from sb3_gqn.gqn import clip_grad_norm
+    from sb3_gqn.targets import clip_grad_norm
 
     parameter = th.nn.Parameter(th.zeros(2))
     parameter.grad = th.tensor([float("nan"), 1.0])

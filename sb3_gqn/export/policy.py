@@ -12,7 +12,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from torch import nn
 
 from sb3_gqn.masking import masked_argmax
-from sb3_gqn.policies import DecoupledQNetwork, critics_maximum
+from sb3_gqn.q_network import DecoupledQNetwork, critics_maximum
 
 if TYPE_CHECKING:
     from sb3_gqn.gqn import GQN
