@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from sb3_gqn.arguments import check_int, check_number
+from sb3_gqn.arguments import check_choice, check_int, check_number
 
 if TYPE_CHECKING:
     from sb3_gqn.gqn import GQN
@@ -190,8 +190,7 @@ class AdaptiveGrowth:
 
     def __post_init__(self) -> None:
         # The constructor's own checks (sb3_gqn.arguments), under the names GQN's arguments carry
-        if self.returns_source not in RETURN_SOURCES:
-            raise ValueError(f"growth_returns must be one of {RETURN_SOURCES}, got {self.returns_source!r}")
+        check_choice("growth_returns", self.returns_source, RETURN_SOURCES)
         self.eval_freq = check_int("growth_eval_freq", self.eval_freq, 1)
         self.eval_episodes = check_int("growth_eval_episodes", self.eval_episodes, 1)
         self.window = check_int("growth_window", self.window, 1)
