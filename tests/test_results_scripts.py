@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "results"))
@@ -59,3 +60,66 @@ def test_growth_step_errors_sign_says_the_opened_bins_end_below_their_neighbours
     assert figures["utility_range"] == pytest.approx(1.4)
     assert figures["linear_bias"] == pytest.approx(0.4 / 1.4)
     assert figures["linear_error"] == pytest.approx(0.4 / 1.4)
+
+
+def _rule_table(runs: list[tuple[str, int, list[float], int, str]]) -> pd.DataFrame:
+    """Rows at 10k, 20k and 100k steps per run ``(algo, seed, returns, final bins, growth_events)``."""
+    rows = [
+        {
+            "algo": algo,
+            "env": "E",
+            "penalty": 0.1,
+            "seed": seed,
+            "step": step,
+            "return": value,
+            "active_bins": bins,
+            "growth_events": events,
+        }
+        for algo, seed, returns, bins, events in runs
+        for step, value in zip([10_000, 20_000, 100_000], returns)
+    ]
+    return pd.DataFrame(rows)
+
+
+def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
+    import decision_rules
+    from decision_rules import Rule, clauses, outcome
+
+    monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0, 1], "gqn-linear": [0]})
+    # gqn-adaptive with the candidate: finals 600, 700 (mean 650); seed 0 grows to 3 at 20k: 200 -> 100 is below
+    # 70 % of 200 (140), a miss; seed 1: 200 -> 150 holds. The shipped entry: finals 500, 400 (mean 450), and its
+    # seed 1 misses once (90 -> 30: more than 50 below a return under 100).
+    runs = [
+        ("gqn-adaptive+new", 0, [200, 100, 600], 9, "20000:3 60000:9"),
+        ("gqn-adaptive+new", 1, [200, 150, 700], 9, "20000:3 60000:9"),
+        ("gqn-adaptive+old", 0, [200, 190, 500], 9, "20000:3"),
+        ("gqn-adaptive+old", 1, [90, 30, 400], 9, "20000:3"),
+        ("gqn-linear+old", 0, [10, 10, 300], 9, ""),
+    ]
+    shipped_like = Rule("R", "t", "E", "+new", "+old", "shipped")
+    none_allowed = Rule("R", "t", "E", "+new", "+old", "none")
+    # gqn-linear's candidate run is missing: the mean and the 1-vs-1 miss count stay open
+    result, missing = clauses(_rule_table(runs), shipped_like)
+    assert missing == {"gqn-linear": [0]}
+    assert [clause.holds for clause in result] == [None, None, None]
+    assert "650.0 vs 450.0" in result[0].figures
+    assert result[1].figures.startswith("1 in 4 events (gqn-adaptive seed 0 -> 3 at 20000: 200 -> 100)")
+    assert outcome(result) == "pending"
+    # ... but a rule that allows no miss has already failed
+    result, _ = clauses(_rule_table(runs), none_allowed)
+    assert [clause.holds for clause in result] == [None, False, None]
+    assert outcome(result) == "not switched"
+    # complete: every clause holds under the shipped-entry comparison
+    complete = [*runs, ("gqn-linear+new", 0, [10, 10, 320], 9, "")]
+    result, missing = clauses(_rule_table(complete), shipped_like)
+    assert missing == {}
+    assert [clause.holds for clause in result] == [True, True, True]
+    assert outcome(result) == "switch"
+    # a candidate gqn-adaptive run short of 9 bins fails clause 3, and a second miss clause 2
+    short = [*complete[:1], ("gqn-adaptive+new", 1, [200, 100, 700], 5, "20000:3"), *complete[2:]]
+    result, _ = clauses(_rule_table(short), shipped_like)
+    assert [clause.holds for clause in result] == [True, False, False]
+    # a run still training (no row at 100k) does not count
+    unfinished = _rule_table(complete)
+    unfinished = unfinished[~((unfinished["algo"] == "gqn-linear+new") & (unfinished["step"] == 100_000))]
+    assert clauses(unfinished, shipped_like)[1] == {"gqn-linear": [0]}

@@ -1,0 +1,180 @@
+"""Apply the entry-change rules of ``decision_rules.md`` to the committed tables (issue 11, item 5).
+
+    python docs/results/decision_rules.py          # every rule: each clause with its figures, and the outcome
+
+A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
+``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
+still training has rows, but none at ``STEPS``). The outcome is ``switch`` once every seed has run and every clause
+holds, ``not switched`` as soon as a clause fails that no further run can mend (a growth miss or a run short of 9
+bins stays in the table), and ``pending`` otherwise. The rules' wording in ``decision_rules.md`` is the authority;
+this script only spares the hand count, and its output is what the outcomes there quote.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import pandas as pd
+
+from sb3_gqn.plots import final_rows
+from sb3_gqn.report import growth_checks
+
+RESULTS = Path(__file__).resolve().parent
+STEPS = 100_000
+#: the seeds every rule needs per agent: the main tables' (gqn-adaptive and decqn-9 0-7, gqn-linear 0-5, decqn-2 0-1)
+RULE_SEEDS: dict[str, list[int]] = {
+    "gqn-adaptive": list(range(8)),
+    "decqn-9": list(range(8)),
+    "gqn-linear": list(range(6)),
+    "decqn-2": list(range(2)),
+}
+#: the GQN agents whose growth events the collapse clause counts
+GROWING_AGENTS = ["gqn-adaptive", "gqn-linear"]
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One entry-change rule: switch ``env``'s entries from ``shipped`` to ``candidate`` iff every clause holds.
+
+    :param misses: ``"none"``: no candidate GQN run may miss the collapse criterion (R1); ``"shipped"``: the
+        candidate's GQN runs may miss it at most as often as the shipped entry's on the same seeds (R2)
+    """
+
+    name: str
+    table: str
+    env: str
+    candidate: str
+    shipped: str
+    misses: Literal["none", "shipped"]
+
+
+RULES = [
+    Rule("R1", "walker-walk_c0.1_100k_torso", "dm_control/walker-walk-v0", "+residual+1update", "+layernorm+1update", "none"),
+    Rule("R2", "finger-spin_c0.1_100k", "dm_control/finger-spin-v0", "+residual+1update", "+layernorm+1update", "shipped"),
+]
+
+
+@dataclass(frozen=True)
+class Clause:
+    """One clause's figures and verdict: ``holds`` is None while it can still go either way."""
+
+    text: str
+    figures: str
+    holds: bool | None
+
+
+def finished_runs(table: pd.DataFrame, env: str) -> pd.DataFrame:
+    """The last row of every run of ``env`` that reached ``STEPS``."""
+    final = final_rows(table[table["env"] == env])
+    return final[final["step"] >= STEPS]
+
+
+def missing_seeds(final: pd.DataFrame, suffix: str) -> dict[str, list[int]]:
+    """Per agent, the rule's seeds without a finished run of the entry ``suffix``."""
+    missing = {}
+    for agent, seeds in RULE_SEEDS.items():
+        done = set(final.loc[final["algo"] == agent + suffix, "seed"].astype(int))
+        if absent := [seed for seed in seeds if seed not in done]:
+            missing[agent] = absent
+    return missing
+
+
+def growth_misses(table: pd.DataFrame, env: str, suffix: str, seeds_of: dict[str, list[int]]) -> list[str]:
+    """The growth events of the entry ``suffix``'s GQN runs on ``seeds_of`` that miss the collapse criterion."""
+    misses = []
+    for check in growth_checks(table[table["env"] == env]):
+        agent = check.algo.removesuffix(suffix) if suffix else check.algo
+        if check.algo != agent + suffix or agent not in GROWING_AGENTS or check.seed not in seeds_of.get(agent, []):
+            continue
+        if check.held is False:
+            misses.append(
+                f"{agent} seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
+            )
+    return misses
+
+
+def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, list[int]]]:
+    """The rule's clauses on ``table`` and the seeds still to run with the candidate entry."""
+    final = finished_runs(table, rule.env)
+    missing = missing_seeds(final, rule.candidate)
+    complete = not missing
+    candidate = final[final["algo"] == "gqn-adaptive" + rule.candidate]
+    shipped = final[final["algo"] == "gqn-adaptive" + rule.shipped]
+    seeds = sorted(set(candidate["seed"].astype(int)) & set(shipped["seed"].astype(int)))
+    candidate_mean = candidate[candidate["seed"].isin(seeds)]["return"].mean()
+    shipped_all_seeds = shipped[shipped["seed"].isin(RULE_SEEDS["gqn-adaptive"])]["return"].mean()
+    shipped_mean = shipped[shipped["seed"].isin(seeds)]["return"].mean()
+    result = [
+        Clause(
+            "gqn-adaptive's 8-seed mean final return above the shipped entry's on the same seeds",
+            f"{candidate_mean:.1f} vs {shipped_mean:.1f} over seeds {seeds} (shipped, seeds 0-7: {shipped_all_seeds:.1f})",
+            bool(candidate_mean > shipped_all_seeds) if complete else None,
+        )
+    ]
+    done_seeds = {
+        agent: sorted(set(final.loc[final["algo"] == agent + rule.candidate, "seed"].astype(int)) & set(RULE_SEEDS[agent]))
+        for agent in GROWING_AGENTS
+    }
+    candidate_misses = growth_misses(table, rule.env, rule.candidate, done_seeds)
+    events = sum(
+        1
+        for check in growth_checks(table[table["env"] == rule.env])
+        for agent in GROWING_AGENTS
+        if check.algo == agent + rule.candidate and check.seed in done_seeds[agent]
+    )
+    if rule.misses == "none":
+        allowed, against = 0, "none allowed"
+    else:
+        shipped_misses = growth_misses(table, rule.env, rule.shipped, RULE_SEEDS)
+        allowed, against = (
+            len(shipped_misses),
+            f"shipped entry, same agents and seeds: {len(shipped_misses)} ({'; '.join(shipped_misses)})",
+        )
+    too_many = len(candidate_misses) > allowed
+    result.append(
+        Clause(
+            "the candidate's GQN runs miss the collapse criterion "
+            + ("nowhere" if rule.misses == "none" else "at most as often as the shipped entry's"),
+            f"{len(candidate_misses)} in {events} events ({'; '.join(candidate_misses) or 'none'}); {against}",
+            False if too_many else (True if complete else None),
+        )
+    )
+    short = candidate[candidate["active_bins"].astype(int) < 9]
+    result.append(
+        Clause(
+            "every gqn-adaptive run with the candidate entry reaches 9 bins",
+            f"{len(candidate) - len(short)} of {len(candidate)} finished runs at 9 bins"
+            + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
+            False if len(short) else (True if complete else None),
+        )
+    )
+    return result, missing
+
+
+def outcome(result: list[Clause]) -> str:
+    """``not switched`` once a clause has failed, ``switch`` once every clause holds, ``pending`` otherwise."""
+    if any(clause.holds is False for clause in result):
+        return "not switched"
+    if all(clause.holds for clause in result):
+        return "switch"
+    return "pending"
+
+
+def main() -> int:
+    for rule in RULES:
+        table = pd.read_csv(RESULTS / rule.table / "results.csv")
+        result, missing = clauses(table, rule)
+        print(f"{rule.name}: {rule.env}, {rule.shipped} -> {rule.candidate}: {outcome(result)}")
+        for number, clause in enumerate(result, start=1):
+            verdict = {True: "holds", False: "FAILS", None: "open"}[clause.holds]
+            print(f"  {number}. {clause.text}: {verdict}\n     {clause.figures}")
+        if missing:
+            print("  still to run: " + ", ".join(f"{agent} {seeds}" for agent, seeds in missing.items()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
