@@ -85,7 +85,7 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     import decision_rules
     from decision_rules import Rule, clauses, outcome
 
-    monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0, 1], "gqn-linear": [0]})
+    monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0, 1], "gqn-linear": [0], "decqn-9": [0]})
     # gqn-adaptive with the candidate: finals 600, 700 (mean 650); seed 0 grows to 3 at 20k: 200 -> 100 is below
     # 70 % of 200 (140), a miss; seed 1: 200 -> 150 holds. The shipped entry: finals 500, 400 (mean 450), and its
     # seed 1 misses once (90 -> 30: more than 50 below a return under 100).
@@ -98,23 +98,28 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     ]
     shipped_like = Rule("R", "t", "E", "+new", "+old", "shipped")
     none_allowed = Rule("R", "t", "E", "+new", "+old", "none")
-    # gqn-linear's candidate run is missing: the mean and the 1-vs-1 miss count stay open
+    # gqn-linear's and decqn-9's candidate runs are missing: gqn-adaptive's clauses (mean 650 > 450, 9 bins) are
+    # decided, the 1-vs-1 miss count stays open, and so does the rule
     result, missing = clauses(_rule_table(runs), shipped_like)
-    assert missing == {"gqn-linear": [0]}
-    assert [clause.holds for clause in result] == [None, None, None]
+    assert missing == {"gqn-linear": [0], "decqn-9": [0]}
+    assert [clause.holds for clause in result] == [True, None, True]
     assert "650.0 vs 450.0" in result[0].figures
     assert result[1].figures.startswith("1 in 4 events (gqn-adaptive seed 0 -> 3 at 20000: 200 -> 100)")
-    assert outcome(result) == "pending"
+    assert outcome(result, missing) == "pending"
     # ... but a rule that allows no miss has already failed
-    result, _ = clauses(_rule_table(runs), none_allowed)
-    assert [clause.holds for clause in result] == [None, False, None]
-    assert outcome(result) == "not switched"
-    # complete: every clause holds under the shipped-entry comparison
-    complete = [*runs, ("gqn-linear+new", 0, [10, 10, 320], 9, "")]
+    result, missing = clauses(_rule_table(runs), none_allowed)
+    assert [clause.holds for clause in result] == [True, False, True]
+    assert outcome(result, missing) == "not switched"
+    # every clause holds under the shipped-entry comparison once gqn-linear has run; the rule waits for decqn-9
+    with_linear = [*runs, ("gqn-linear+new", 0, [10, 10, 320], 9, "")]
+    result, missing = clauses(_rule_table(with_linear), shipped_like)
+    assert missing == {"decqn-9": [0]}
+    assert [clause.holds for clause in result] == [True, True, True]
+    assert outcome(result, missing) == "pending"
+    complete = [*with_linear, ("decqn-9+new", 0, [0, 0, 500], 9, "")]
     result, missing = clauses(_rule_table(complete), shipped_like)
     assert missing == {}
-    assert [clause.holds for clause in result] == [True, True, True]
-    assert outcome(result) == "switch"
+    assert outcome(result, missing) == "switch"
     # a candidate gqn-adaptive run short of 9 bins fails clause 3, and a second miss clause 2
     short = [*complete[:1], ("gqn-adaptive+new", 1, [200, 100, 700], 5, "20000:3"), *complete[2:]]
     result, _ = clauses(_rule_table(short), shipped_like)
@@ -123,3 +128,6 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     unfinished = _rule_table(complete)
     unfinished = unfinished[~((unfinished["algo"] == "gqn-linear+new") & (unfinished["step"] == 100_000))]
     assert clauses(unfinished, shipped_like)[1] == {"gqn-linear": [0]}
+    # a lower candidate mean fails clause 1 once gqn-adaptive's seeds have run: (600 + 250) / 2 = 425 < 450
+    lower = [*complete[:1], ("gqn-adaptive+new", 1, [200, 150, 250], 9, "20000:3 60000:9"), *complete[2:]]
+    assert clauses(_rule_table(lower), shipped_like)[0][0].holds is False

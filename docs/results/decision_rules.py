@@ -4,9 +4,10 @@
 
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
-still training has rows, but none at ``STEPS``). The outcome is ``switch`` once every seed has run and every clause
-holds, ``not switched`` as soon as a clause fails that no further run can mend (a growth miss or a run short of 9
-bins stays in the table), and ``pending`` otherwise. The rules' wording in ``decision_rules.md`` is the authority;
+still training has rows, but none at ``STEPS``). A clause is decided once the seeds it reads have run (gqn-adaptive's
+for the mean and the 9 bins, both GQN agents' for the misses). The outcome is ``switch`` once every seed has run and
+every clause holds, ``not switched`` as soon as a clause fails that no further run can mend (a growth miss or a run
+short of 9 bins stays in the table), and ``pending`` otherwise. The rules' wording in ``decision_rules.md`` is the authority;
 this script only spares the hand count, and its output is what the outcomes there quote.
 """
 
@@ -100,7 +101,9 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
     """The rule's clauses on ``table`` and the seeds still to run with the candidate entry."""
     final = finished_runs(table, rule.env)
     missing = missing_seeds(final, rule.candidate)
-    complete = not missing
+    # a clause is decided once the seeds it reads have run (the rule's outcome waits for every seed)
+    adaptive_done = "gqn-adaptive" not in missing
+    growth_done = not any(agent in missing for agent in GROWING_AGENTS)
     candidate = final[final["algo"] == "gqn-adaptive" + rule.candidate]
     shipped = final[final["algo"] == "gqn-adaptive" + rule.shipped]
     seeds = sorted(set(candidate["seed"].astype(int)) & set(shipped["seed"].astype(int)))
@@ -111,7 +114,7 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
         Clause(
             "gqn-adaptive's 8-seed mean final return above the shipped entry's on the same seeds",
             f"{candidate_mean:.1f} vs {shipped_mean:.1f} over seeds {seeds} (shipped, seeds 0-7: {shipped_all_seeds:.1f})",
-            bool(candidate_mean > shipped_all_seeds) if complete else None,
+            bool(candidate_mean > shipped_all_seeds) if adaptive_done else None,
         )
     ]
     done_seeds = {
@@ -139,7 +142,7 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
             "the candidate's GQN runs miss the collapse criterion "
             + ("nowhere" if rule.misses == "none" else "at most as often as the shipped entry's"),
             f"{len(candidate_misses)} in {events} events ({'; '.join(candidate_misses) or 'none'}); {against}",
-            False if too_many else (True if complete else None),
+            False if too_many else (True if growth_done else None),
         )
     )
     short = candidate[candidate["active_bins"].astype(int) < 9]
@@ -148,17 +151,18 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
             "every gqn-adaptive run with the candidate entry reaches 9 bins",
             f"{len(candidate) - len(short)} of {len(candidate)} finished runs at 9 bins"
             + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
-            False if len(short) else (True if complete else None),
+            False if len(short) else (True if adaptive_done else None),
         )
     )
     return result, missing
 
 
-def outcome(result: list[Clause]) -> str:
-    """``not switched`` once a clause has failed, ``switch`` once every clause holds, ``pending`` otherwise."""
+def outcome(result: list[Clause], missing: dict[str, list[int]]) -> str:
+    """``not switched`` once a clause has failed, ``switch`` once every clause holds and no seed is ``missing``,
+    ``pending`` otherwise."""
     if any(clause.holds is False for clause in result):
         return "not switched"
-    if all(clause.holds for clause in result):
+    if all(clause.holds for clause in result) and not missing:
         return "switch"
     return "pending"
 
@@ -167,7 +171,7 @@ def main() -> int:
     for rule in RULES:
         table = pd.read_csv(RESULTS / rule.table / "results.csv")
         result, missing = clauses(table, rule)
-        print(f"{rule.name}: {rule.env}, {rule.shipped} -> {rule.candidate}: {outcome(result)}")
+        print(f"{rule.name}: {rule.env}, {rule.shipped} -> {rule.candidate}: {outcome(result, missing)}")
         for number, clause in enumerate(result, start=1):
             verdict = {True: "holds", False: "FAILS", None: "open"}[clause.holds]
             print(f"  {number}. {clause.text}: {verdict}\n     {clause.figures}")
