@@ -91,6 +91,16 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive", "policy_kwargs": "dict(n_critics=2)"}),
 }
+
+
+def warm_started(algo: str) -> bool:
+    """Whether runner variant ``algo`` opens bins with a warm start (``growth_init="interpolate"``, the class default
+    and every shipped entry's): all variants but the ``gqn-before`` ablation's without ``+warm-start``. Names the
+    runner does not know (tables written elsewhere) count as warm-started, the default."""
+    _, overrides = VARIANTS.get(algo, ("gqn", {}))
+    return overrides.get("growth_init", "interpolate") == "interpolate"
+
+
 ABLATION = ["gqn-before", "gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared", "gqn-adaptive"]
 SHORT_SUITE = dict(
     algos=["gqn-linear", "decqn-2", "decqn-9", "sac"], envs=["Pendulum-v1"], penalties=[0.1], seeds=[0], steps=10_000

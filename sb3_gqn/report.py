@@ -10,8 +10,9 @@ Prints, from the tables alone (no model files needed, so committed tables are en
 
 * the final greedy evaluation of every run (return, task return, P, |Δa|, SM, bins, training seconds);
 * per algorithm and task, the mean final return and SM over seeds;
-* the growth check of every GQN run: for each growth event, the last evaluation before it and the first
-  after it, and whether the return held (held_after_growth);
+* the growth check of every GQN run: for each growth event, the last evaluation of the policy before it and
+  the first after it that the growth can have changed (growth_checks), and whether the return held
+  (held_after_growth);
 * rliable's IQM of min-max normalized final returns across the tasks, with 95 % bootstrap intervals;
 * with --compare A:B, how far the seeds resolve each comparison of A with B (sb3_gqn.significance): the IQM
   difference and P(A > B) across tasks, and per task the difference of mean final return and of mean SM, each
@@ -29,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from sb3_gqn.benchmark import warm_started
 from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores, run_growth_events
 from sb3_gqn.significance import (
     difference_interval,
@@ -70,17 +72,26 @@ class GrowthCheck:
 
 
 def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
-    """Every growth event of every run in ``table`` with the last evaluation before and the first after it.
+    """Every growth event of every run in ``table`` with the last evaluation of the policy before it and the first
+    evaluation after it that the growth can have changed.
 
-    An evaluation at the very step of a growth comes after it (the growth callback runs before every other
-    callback of that step, so that evaluation already acts with the new bins: its ``active_bins`` say so).
+    An evaluation at the very step of a growth runs after it (the growth callback runs before every other callback
+    of that step) and with the new bins. With a warm start (:func:`~sb3_gqn.benchmark.warm_started`) each opened
+    bin's utility is the mean of its two neighbours', never above the larger, so that evaluation acts exactly as the
+    policy before the growth: it is the last one *before*, and the first *after* is the next one (at least one
+    gradient step at the new level). Without a warm start the opened bins' untrained utilities act at once, so that
+    evaluation is the first *after* (the jump the issue calls a collapse).
     """
     checks = []
     for (algo, env, _, seed), run in table.groupby(["algo", "env", "penalty", "seed"]):
         run = run.sort_values("step")
         steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
+        evaluation_at_growth_is_before = warm_started(str(algo))
         for step, bins in run_growth_events(run):
-            earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
+            if evaluation_at_growth_is_before:
+                earlier, later = np.flatnonzero(steps <= step), np.flatnonzero(steps > step)
+            else:
+                earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
             checks.append(
                 GrowthCheck(
                     str(algo),

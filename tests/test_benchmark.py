@@ -23,6 +23,7 @@ from sb3_gqn.benchmark import (
     parse_args,
     penalized_wrappers,
     untrained_runs,
+    warm_started,
 )
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
@@ -290,3 +291,11 @@ def test_the_local_runner_imports_no_ray():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip().splitlines()[-1] == "False"
+
+
+def test_warm_started_is_every_variant_but_the_cold_ablation():
+    assert not warm_started("gqn-before") and not warm_started("gqn-before+plateau")
+    assert not warm_started("gqn-before+shared")
+    assert warm_started("gqn-before+warm-start") and warm_started("gqn-adaptive") and warm_started("gqn-linear")
+    assert warm_started("gqn-adaptive+residual+1update")
+    assert warm_started("a-table-from-elsewhere")  # the class default

@@ -286,6 +286,25 @@ def test_interpolate_warm_start_sets_new_bins_to_the_mean_of_their_neighbours():
     assert bool((q[..., 4] <= th.maximum(q[..., 0], q[..., 8]) + 1e-6).all())
 
 
+def test_interpolate_warm_start_keeps_every_greedy_action_when_a_level_opens():
+    """What the report's growth check relies on: an evaluation right after a warm-started growth acts exactly as
+    the policy before it (the opened bins sit between their neighbours), whereas without the warm start it can
+    jump."""
+    observations = np.random.default_rng(1).normal(size=(500, 3)).astype(np.float32)
+    changed = {}
+    for growth_init in ("interpolate", "none"):
+        model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth=None, growth_init=growth_init, bins=(2, 9), **SMALL)
+        _randomize_head(model)
+        changed[growth_init] = 0
+        for _ in range(3):
+            before, _ = model.predict(observations, deterministic=True)
+            model.grow()
+            after, _ = model.predict(observations, deterministic=True)
+            changed[growth_init] += int((before != after).any(axis=-1).sum())
+    assert changed["interpolate"] == 0
+    assert changed["none"] > 0  # the randomized untrained rows win the argmax in some states
+
+
 def test_a_jump_over_several_levels_interpolates_level_by_level():
     model = GQN("MlpPolicy", DecliningEnv(action_dims=2), growth=None, bins=(2, 9), **SMALL)
     _randomize_head(model)

@@ -51,15 +51,32 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
         (19000, 5, 10_000, 400.0, 20_000, 500.0, True),
         (25000, 9, 20_000, 500.0, 30_000, 200.0, False),  # 200 < 0.7 * 500
     ]
-    # Linear growth at an evaluation step: that evaluation already ran with the new bins, so it is "after"
-    linear = pd.DataFrame([_row("gqn-linear", 0, 10_000, 300.0), _row("gqn-linear", 0, 20_000, 100.0, "20000:3")])
+    # Warm-started growth at an evaluation step: that evaluation acts as the policy before the growth (the opened
+    # bins sit between their neighbours), so it is the last one before and the next one is the first after
+    linear = pd.DataFrame(
+        [
+            _row("gqn-linear", 0, 10_000, 300.0),
+            _row("gqn-linear", 0, 20_000, 280.0, "20000:3"),
+            _row("gqn-linear", 0, 30_000, 150.0, "20000:3"),
+        ]
+    )
     [check] = growth_checks(linear)
+    assert (check.before_step, check.before, check.after_step, check.after, check.held) == (
+        20_000,
+        280.0,
+        30_000,
+        150.0,
+        False,  # 150 < 0.7 * 280 = 196 (300 -> 280 at the growth step would have held)
+    )
+    # Without a warm start (the ablation's gqn-before) the untrained bins act at once: that evaluation is "after"
+    cold = linear.assign(algo="gqn-before")
+    [check] = growth_checks(cold)
     assert (check.before_step, check.before, check.after_step, check.after, check.held) == (
         10_000,
         300.0,
         20_000,
-        100.0,
-        False,
+        280.0,
+        True,  # 280 >= 0.7 * 300 = 210
     )
     text = report(table, reps=50)
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 30000 | 200 |" in text

@@ -86,14 +86,14 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     from decision_rules import Rule, clauses, outcome
 
     monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0, 1], "gqn-linear": [0], "decqn-9": [0]})
-    # gqn-adaptive with the candidate: finals 600, 700 (mean 650); seed 0 grows to 3 at 20k: 200 -> 100 is below
-    # 70 % of 200 (140), a miss; seed 1: 200 -> 150 holds. The shipped entry: finals 500, 400 (mean 450), and its
-    # seed 1 misses once (90 -> 30: more than 50 below a return under 100).
+    # gqn-adaptive with the candidate: finals 600, 700 (mean 650); seed 0 grows to 3 at 15k (between the evaluations
+    # at 10k and 20k): 200 -> 100 is below 70 % of 200 (140), a miss; seed 1: 200 -> 150 holds. The shipped entry:
+    # finals 500, 400 (mean 450), and its seed 1 misses once (90 -> 30: more than 50 below a return under 100).
     runs = [
-        ("gqn-adaptive+new", 0, [200, 100, 600], 9, "20000:3 60000:9"),
-        ("gqn-adaptive+new", 1, [200, 150, 700], 9, "20000:3 60000:9"),
-        ("gqn-adaptive+old", 0, [200, 190, 500], 9, "20000:3"),
-        ("gqn-adaptive+old", 1, [90, 30, 400], 9, "20000:3"),
+        ("gqn-adaptive+new", 0, [200, 100, 600], 9, "15000:3 60000:9"),
+        ("gqn-adaptive+new", 1, [200, 150, 700], 9, "15000:3 60000:9"),
+        ("gqn-adaptive+old", 0, [200, 190, 500], 9, "15000:3"),
+        ("gqn-adaptive+old", 1, [90, 30, 400], 9, "15000:3"),
         ("gqn-linear+old", 0, [10, 10, 300], 9, ""),
     ]
     shipped_like = Rule("R", "t", "E", "+new", "+old", "shipped")
@@ -104,7 +104,7 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     assert missing == {"gqn-linear": [0], "decqn-9": [0]}
     assert [clause.holds for clause in result] == [True, None, True]
     assert "650.0 vs 450.0" in result[0].figures
-    assert result[1].figures.startswith("1 in 4 events (gqn-adaptive seed 0 -> 3 at 20000: 200 -> 100)")
+    assert result[1].figures.startswith("1 in 4 events (gqn-adaptive seed 0 -> 3 at 15000: 200 -> 100)")
     assert outcome(result, missing) == "pending"
     # ... but a rule that allows no miss has already failed
     result, missing = clauses(_rule_table(runs), none_allowed)
@@ -121,7 +121,7 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     assert missing == {}
     assert outcome(result, missing) == "switch"
     # a candidate gqn-adaptive run short of 9 bins fails clause 3, and a second miss clause 2
-    short = [*complete[:1], ("gqn-adaptive+new", 1, [200, 100, 700], 5, "20000:3"), *complete[2:]]
+    short = [*complete[:1], ("gqn-adaptive+new", 1, [200, 100, 700], 5, "15000:3"), *complete[2:]]
     result, _ = clauses(_rule_table(short), shipped_like)
     assert [clause.holds for clause in result] == [True, False, False]
     # a run still training (no row at 100k) does not count
@@ -129,5 +129,5 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     unfinished = unfinished[~((unfinished["algo"] == "gqn-linear+new") & (unfinished["step"] == 100_000))]
     assert clauses(unfinished, shipped_like)[1] == {"gqn-linear": [0]}
     # a lower candidate mean fails clause 1 once gqn-adaptive's seeds have run: (600 + 250) / 2 = 425 < 450
-    lower = [*complete[:1], ("gqn-adaptive+new", 1, [200, 150, 250], 9, "20000:3 60000:9"), *complete[2:]]
+    lower = [*complete[:1], ("gqn-adaptive+new", 1, [200, 150, 250], 9, "15000:3 60000:9"), *complete[2:]]
     assert clauses(_rule_table(lower), shipped_like)[0][0].holds is False

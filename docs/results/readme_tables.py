@@ -94,7 +94,8 @@ def main_comparison() -> str:
             sections["final"].body,
             "**Mean over seeds**",
             sections["means"].body,
-            f"**{sections['growth'].heading}**; an evaluation at the step of a growth is already after it",
+            f"**{sections['growth'].heading}**; with the warm start an evaluation at the step of a growth acts as the "
+            "policy before it, so the next one is the first after",
             sections["growth"].body,
             f"**{sections['iqm'].heading}**",
             sections["iqm"].body,
