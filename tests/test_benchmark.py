@@ -207,17 +207,20 @@ def readme_tables():
     return module
 
 
-def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update_variants():
+def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants():
     """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
-    under the plain names: that holds only while they train exactly what the shipped entries train."""
-    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, run_overrides
+    under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
+    residual torso, by rule R1; finger: DecQN's default torso)."""
+    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, RESIDUAL_TORSO, run_overrides
 
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
-    assert {walker: "+layernorm+1update", finger: "+layernorm+1update"} == readme_tables().SHIPPED
+    assert {walker: "+residual+1update", finger: "+layernorm+1update"} == readme_tables().SHIPPED
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
+        assert trained(algo, walker) == trained(f"{algo}+residual+1update", walker)
+        assert trained(algo, finger) == trained(f"{algo}+layernorm+1update", finger)
+        assert trained(algo, walker)["policy_kwargs"] == RESIDUAL_TORSO
         for env in (walker, finger):
-            assert trained(algo, env) == trained(f"{algo}+layernorm+1update", env)
             assert trained(algo, env)["train_freq"] == 1
         # cartpole (the main job) keeps the plain MLP and 1 update per 2 env steps
         assert trained(algo, cartpole)["train_freq"] == 2 and "policy_kwargs" not in trained(algo, cartpole)
@@ -234,17 +237,21 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_the_layernorm_1update
         }
 
 
-def test_the_residual_1update_variants_are_the_walker_entries_with_only_the_torso_swapped():
-    """The candidate for walker's entry (issue 11 item 5): each of the four agents' ``+residual+1update`` variant
-    trains walker's shipped entry with DecQN's residual torso and nothing else changed, so its runs compare with
-    the shipped ones seed for seed."""
-    from sb3_gqn.benchmark import RESIDUAL_TORSO
+def test_the_torso_variants_differ_from_the_entries_only_in_the_torso():
+    """Issue 11 item 5: walker's earlier entry (``+layernorm+1update``) and finger's residual candidate
+    (``+residual+1update``) each train the task's shipped entry with the other torso and nothing else changed, so
+    their runs compare with the shipped ones seed for seed."""
+    from sb3_gqn.benchmark import REFERENCE_TORSO, RESIDUAL_TORSO
 
-    walker = "dm_control/walker-walk-v0"
+    walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
-        shipped, candidate = trained(algo, walker), trained(f"{algo}+residual+1update", walker)
-        assert {key for key in shipped | candidate if shipped.get(key) != candidate.get(key)} == {"policy_kwargs"}
-        assert candidate["policy_kwargs"] == RESIDUAL_TORSO
+        for env, other, torso in [
+            (walker, "+layernorm+1update", REFERENCE_TORSO),
+            (finger, "+residual+1update", RESIDUAL_TORSO),
+        ]:
+            shipped, candidate = trained(algo, env), trained(f"{algo}{other}", env)
+            assert {key for key in shipped | candidate if shipped.get(key) != candidate.get(key)} == {"policy_kwargs"}
+            assert candidate["policy_kwargs"] == torso
 
 
 def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_compare_probes_with_the_entry_before():
@@ -265,8 +272,9 @@ def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_
     with pytest.raises(SystemExit, match=re.escape(f"decqn-9{suffix} (the shipped entry) lacks seeds [1]")):
         tables.shipped(pd.concat([first_entry, shipped.iloc[:-1]], ignore_index=True))
 
-    assert tables.entry_before(walker, "+residual+1update") == "+layernorm+1update"
-    assert tables.entry_before(walker, "+layernorm+1update") == ""  # a probe that is the shipped entry: the one before
+    assert tables.entry_before(walker, "+residual+1update") == "+layernorm+1update"  # the shipped entry: the one before
+    assert tables.entry_before(walker, "+layernorm+1update") == "+residual+1update"
+    assert tables.entry_before("dm_control/finger-spin-v0", "+layernorm+1update") == ""
     assert tables.entry_before(cartpole, "+residual") == ""
 
 

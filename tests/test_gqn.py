@@ -382,7 +382,8 @@ def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
     ],
 )
 def test_every_torso_option_learns_grows_and_round_trips(torso, tmp_path):
-    """The documented torso options (walker's shipped entry uses the first) train through growth and load back."""
+    """The documented torso options (finger's shipped entry uses the first, walker's the last) train through growth and
+    load back."""
     options = {**SMALL, "policy_kwargs": dict(net_arch=[32, 32], **torso)}
     model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, **options)
     model.learn(400)
