@@ -131,3 +131,28 @@ def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     # a lower candidate mean fails clause 1 once gqn-adaptive's seeds have run: (600 + 250) / 2 = 425 < 450
     lower = [*complete[:1], ("gqn-adaptive+new", 1, [200, 150, 250], 9, "15000:3 60000:9"), *complete[2:]]
     assert clauses(_rule_table(lower), shipped_like)[0][0].holds is False
+
+
+def test_evaluation_drops_count_pairs_after_the_last_growth_only():
+    from evaluation_drops import evaluation_drops
+
+    steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
+
+    def run(algo: str, returns: list[float], events: str) -> list[dict]:
+        return [
+            {"env": "E", "algo": algo, "seed": 0, "step": step, "return": value, "growth_events": events}
+            for step, value in zip(steps, returns)
+        ]
+
+    table = pd.DataFrame(
+        # GQN's last growth is at 40k: its evaluation there still acts as the 5-bin policy, so only 50k -> 60k
+        # counts, and 340 -> 200 drops (200 < 0.7 * 340 = 238); 500 -> 340 would have dropped too (340 < 350)
+        run("gqn", [10, 100, 300, 500, 340, 200], "20000:3 30000:5 40000:9")
+        # DecQN never grows: every pair from 30k on; 80 -> 20 is more than 50 below a return under 100, a drop;
+        # 20 -> 60 and 60 -> 100 hold
+        + run("decqn", [0, 50, 80, 20, 60, 100], "")
+    )
+    by_algo = {drops.algo: drops for drops in evaluation_drops(table, start=30_000)}
+    assert (by_algo["gqn"].pairs, by_algo["gqn"].drops) == (1, ["0@60k 340 -> 200"])
+    assert (by_algo["decqn"].pairs, by_algo["decqn"].drops) == (3, ["0@40k 80 -> 20"])
+    assert by_algo["decqn"].share == pytest.approx(1 / 3)

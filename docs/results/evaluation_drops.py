@@ -1,0 +1,85 @@
+"""How often an evaluation drops by the collapse criterion's margin when no growth happened: the scale for the
+growth checks' misses (issue 11).
+
+The growth check (``sb3_gqn.report.growth_checks``) calls a growth missed when the first evaluation it can have
+changed is below 70 % of the last one before it (within 50 below 100: ``held_after_growth``). The same test on two
+consecutive evaluations of a run *after its last growth* (the earlier one already acts with the final level, and
+both are at or after ``--start`` steps) says how often a policy whose resolution no longer changes drops that far
+between two evaluations: evaluation noise (3 greedy episodes) and training instability together. DecQN's runs,
+which never grow, give every pair from ``--start`` on. Printed per task and runner variant: the pairs, the drops
+and their share, and each drop as ``seed@step before -> after``.
+
+    .venv/bin/python docs/results/evaluation_drops.py                                  # the comparison tables
+    .venv/bin/python docs/results/evaluation_drops.py --tables finger-spin_c0.1_100k --start 20000
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from sb3_gqn.plots import run_growth_events
+from sb3_gqn.report import held_after_growth
+
+RESULTS = Path(__file__).resolve().parent
+TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k_torso"]
+
+
+@dataclass
+class Drops:
+    """One agent's consecutive-evaluation pairs after its last growth on one task, and the ones that dropped."""
+
+    env: str
+    algo: str
+    pairs: int = 0
+    drops: list[str] = field(default_factory=list)
+
+    @property
+    def share(self) -> float:
+        return len(self.drops) / self.pairs if self.pairs else float("nan")
+
+
+def evaluation_drops(table: pd.DataFrame, start: int) -> list[Drops]:
+    """Per (env, algo): consecutive evaluations of each run, both after the run's last growth and at or after
+    ``start``, and those where the later one misses ``held_after_growth`` against the earlier one."""
+    result = []
+    for (env, algo), runs in table.groupby(["env", "algo"]):
+        drops = Drops(str(env), str(algo))
+        for seed, run in runs.groupby("seed"):
+            run = run.sort_values("step")
+            steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
+            last_growth = max((step for step, _ in run_growth_events(run)), default=-1)
+            # an evaluation at the growth step itself still acts as the level before (warm start): strictly after
+            usable = np.flatnonzero((steps > last_growth) & (steps >= start))
+            for earlier, later in itertools.pairwise(usable):
+                drops.pairs += 1
+                if not held_after_growth(returns[earlier], returns[later]):
+                    drops.drops.append(f"{seed}@{steps[later] // 1000}k {returns[earlier]:.0f} -> {returns[later]:.0f}")
+        result.append(drops)
+    return result
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--tables", nargs="+", default=TABLES, help="folders under docs/results with a results.csv")
+    parser.add_argument("--start", type=int, default=30_000, help="first evaluation step a pair may use")
+    args = parser.parse_args(argv)
+    for name in args.tables:
+        table = pd.read_csv(RESULTS / name / "results.csv")
+        table = table[~table["algo"].isin(["sac", "td3"])]
+        for drops in evaluation_drops(table, args.start):
+            print(
+                f"{drops.env.split('/')[-1]:22s} {drops.algo:32s} pairs {drops.pairs:3d}  drops {len(drops.drops):2d}"
+                f"  ({drops.share:.1%})  {' '.join(drops.drops)}"
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
