@@ -88,9 +88,12 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-9+residual+1update": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     "gqn-linear+residual+1update": ("gqn", {"growth": "linear", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     "decqn-2+residual+1update": ("decqn", {"bins": 2, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
-    # two critics (DecQN's use_double_q) on the entry's own torso and update ratio
-    "gqn-adaptive+twin": ("gqn", {"growth": "adaptive", "policy_kwargs": "dict(n_critics=2)"}),
+    # two critics (DecQN's use_double_q) on the entry's own torso and update ratio (POLICY_KWARGS_ADDED)
+    "gqn-adaptive+twin": ("gqn", {"growth": "adaptive"}),
 }
+#: Policy keyword arguments a variant adds to its entry's ``policy_kwargs`` (keeping the entry's torso), as the
+#: source of a ``dict(...)`` call like the entries' own
+POLICY_KWARGS_ADDED: dict[str, str] = {"gqn-adaptive+twin": "n_critics=2"}
 
 
 def warm_started(algo: str) -> bool:
@@ -174,7 +177,23 @@ def run_overrides(spec: RunSpec) -> tuple[str, dict[str, Any]]:
     zoo_algo, overrides = VARIANTS[spec.algo]
     if spec.algo.startswith("gqn-before"):
         overrides = {**ENTRIES_BEFORE_ISSUE_11.get(spec.env, {}), **overrides}
+    if spec.algo in POLICY_KWARGS_ADDED:
+        entry_kwargs = _shipped_entry(zoo_algo, spec.env).get("policy_kwargs")
+        overrides = {**overrides, "policy_kwargs": added_policy_kwargs(entry_kwargs, POLICY_KWARGS_ADDED[spec.algo])}
     return zoo_algo, overrides
+
+
+def added_policy_kwargs(entry_kwargs: str | None, added: str) -> str:
+    """An entry's ``policy_kwargs`` source (``"dict(...)"`` or none) with the keyword arguments ``added``:
+    ``added_policy_kwargs("dict(residual_layer_norm=True)", "n_critics=2")`` is
+    ``"dict(residual_layer_norm=True, n_critics=2)"``."""
+    if entry_kwargs is None:
+        return f"dict({added})"
+    source = str(entry_kwargs).strip()
+    if not (source.startswith("dict(") and source.endswith(")")):
+        raise ValueError(f"Cannot add {added!r} to policy_kwargs {source!r}: expected 'dict(...)'")
+    inner = source[len("dict(") : -1].strip()
+    return f"dict({inner}, {added})" if inner else f"dict({added})"
 
 
 def learning_starts(spec: RunSpec) -> int:

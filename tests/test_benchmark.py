@@ -307,3 +307,19 @@ def test_warm_started_is_every_variant_but_the_cold_ablation():
     assert warm_started("gqn-before+warm-start") and warm_started("gqn-adaptive") and warm_started("gqn-linear")
     assert warm_started("gqn-adaptive+residual+1update")
     assert warm_started("a-table-from-elsewhere")  # the class default
+
+
+def test_two_critics_keep_the_entry_torso():
+    """``gqn-adaptive+twin`` adds DecQN's second critic to the entry's own torso (walker's residual one: the reference
+    as its experiments run it), not in place of it."""
+    from sb3_gqn.benchmark import added_policy_kwargs
+
+    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
+        "dict(residual_layer_norm=True, n_critics=2)"
+    )
+    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["train_freq"] == 1
+    # cartpole's entry has no policy_kwargs: its recorded twin runs trained exactly this
+    assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0")["policy_kwargs"] == "dict(n_critics=2)"
+    assert added_policy_kwargs("dict()", "n_critics=2") == "dict(n_critics=2)"
+    with pytest.raises(ValueError, match="expected 'dict"):
+        added_policy_kwargs("{'a': 1}", "n_critics=2")

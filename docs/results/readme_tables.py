@@ -133,7 +133,7 @@ RESIDUAL_SUFFIXES = {
     "dm_control/walker-walk-v0": "+residual+1update",
 }
 #: two critics (``policy_kwargs=dict(n_critics=2)``) on the task's shipped torso and update ratio
-TWIN_SUFFIXES = {"dm_control/cartpole-swingup-v0": "+twin"}
+TWIN_SUFFIXES = {"dm_control/cartpole-swingup-v0": "+twin", "dm_control/walker-walk-v0": "+twin"}
 
 
 def entry_before(env: str, suffix: str) -> str:
