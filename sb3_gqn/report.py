@@ -71,6 +71,14 @@ class GrowthCheck:
         return held_after_growth(self.before, self.after)
 
 
+def evaluations_around(steps: np.ndarray, growth_step: int, algo: str) -> tuple[np.ndarray, np.ndarray]:
+    """Indices into ``steps`` (a run's evaluation steps, sorted) of the evaluations of the policy before a growth at
+    ``growth_step`` and of those the growth can have changed, for runner variant ``algo`` (see growth_checks)."""
+    if warm_started(algo):  # the evaluation at the growth step still acts as the level before
+        return np.flatnonzero(steps <= growth_step), np.flatnonzero(steps > growth_step)
+    return np.flatnonzero(steps < growth_step), np.flatnonzero(steps >= growth_step)
+
+
 def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
     """Every growth event of every run in ``table`` with the last evaluation of the policy before it and the first
     evaluation after it that the growth can have changed.
@@ -86,12 +94,8 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
     for (algo, env, _, seed), run in table.groupby(["algo", "env", "penalty", "seed"]):
         run = run.sort_values("step")
         steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
-        evaluation_at_growth_is_before = warm_started(str(algo))
         for step, bins in run_growth_events(run):
-            if evaluation_at_growth_is_before:
-                earlier, later = np.flatnonzero(steps <= step), np.flatnonzero(steps > step)
-            else:
-                earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
+            earlier, later = evaluations_around(steps, step, str(algo))
             checks.append(
                 GrowthCheck(
                     str(algo),

@@ -21,11 +21,10 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from sb3_gqn.plots import run_growth_events
-from sb3_gqn.report import held_after_growth
+from sb3_gqn.report import evaluations_around, held_after_growth
 
 RESULTS = Path(__file__).resolve().parent
 TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k_torso"]
@@ -55,8 +54,8 @@ def evaluation_drops(table: pd.DataFrame, start: int) -> list[Drops]:
             run = run.sort_values("step")
             steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
             last_growth = max((step for step, _ in run_growth_events(run)), default=-1)
-            # an evaluation at the growth step itself still acts as the level before (warm start): strictly after
-            usable = np.flatnonzero((steps > last_growth) & (steps >= start))
+            _, after_last_growth = evaluations_around(steps, last_growth, str(algo))
+            usable = after_last_growth[steps[after_last_growth] >= start]
             for earlier, later in itertools.pairwise(usable):
                 drops.pairs += 1
                 if not held_after_growth(returns[earlier], returns[later]):
