@@ -156,3 +156,62 @@ def test_evaluation_drops_count_pairs_after_the_last_growth_only():
     assert (by_algo["gqn"].pairs, by_algo["gqn"].drops) == (1, ["0@60k 340 -> 200"])
     assert (by_algo["decqn"].pairs, by_algo["decqn"].drops) == (3, ["0@40k 80 -> 20"])
     assert by_algo["decqn"].share == pytest.approx(1 / 3)
+
+
+def test_probe_rule_clauses_on_hand_made_tables():
+    from decision_rules import ProbeRule, outcome, probe_clauses
+
+    def table(runs: list[tuple[str, int, list[float], int, str, float]]) -> pd.DataFrame:
+        frame = _rule_table([run[:5] for run in runs])
+        final_smoothness = {(algo, seed): value for algo, seed, *_, value in runs}
+        frame["smoothness"] = [final_smoothness[(algo, seed)] for algo, seed in zip(frame["algo"], frame["seed"])]
+        return frame
+
+    rule = ProbeRule(
+        "R", "P", "E", "gqn-adaptive+x", [0, 1], ("T", "decqn-9+x"), [("S", "sac", 0.0), ("T", "gqn-adaptive+x", -50.0)]
+    )
+    # bars: decqn-9's SM (0.011 + 0.013) / 2 = 0.012; SAC's return (500 + 600) / 2 = 550; the shipped entry's
+    # (700 + 700) / 2 - 50 = 650
+    ceiling_and_floor = table(
+        [
+            ("decqn-9+x", 0, [0, 0, 400], 9, "", 0.011),
+            ("decqn-9+x", 1, [0, 0, 400], 9, "", 0.013),
+            ("gqn-adaptive+x", 0, [0, 0, 700], 9, "", 0.02),
+            ("gqn-adaptive+x", 1, [0, 0, 700], 9, "", 0.02),
+        ]
+    )
+    sac = table([("sac", 0, [0, 0, 500], 0, "", 0.005), ("sac", 1, [0, 0, 600], 0, "", 0.005)])
+    # the probe: finals 600 and 700 (mean 650, exactly the floor), SM 0.010 and 0.012 (mean 0.011); growths at 15k
+    # (200 -> 150 and 200 -> 180, both at least 70 % of 200) and at 60k (judged 20k -> 100k: 150 -> 600, 180 -> 700)
+    probe_runs = [
+        ("gqn-adaptive+x", 0, [200, 150, 600], 9, "15000:3 60000:9", 0.010),
+        ("gqn-adaptive+x", 1, [200, 180, 700], 9, "15000:3 60000:9", 0.012),
+    ]
+
+    def apply(runs: list) -> tuple[list, dict]:
+        return probe_clauses({"P": table(runs), "T": ceiling_and_floor, "S": sac}, rule)
+
+    result, missing = apply(probe_runs)
+    assert missing == {}
+    assert [clause.holds for clause in result] == [True, True, True, True]
+    assert "0.01100 vs 0.01200" in result[0].figures
+    assert "650.0" in result[1].figures and "sac = 550.0" in result[1].figures
+    assert "= 650.0" in result[1].figures
+    assert result[2].figures.startswith("0 in 4 events")
+    assert outcome(result, missing) == "switch"
+    # one seed short: the means wait, and so does the rule
+    result, missing = apply(probe_runs[:1])
+    assert missing == {"gqn-adaptive": [1]}
+    assert [clause.holds for clause in result] == [None, None, None, None]
+    assert outcome(result, missing) == "pending"
+    # a missed growth (200 -> 130, below 140) or a run short of 9 bins decides at once
+    missed = [("gqn-adaptive+x", 0, [200, 130, 600], 9, "15000:3 60000:9", 0.010)]
+    assert [clause.holds for clause in apply(missed)[0]] == [None, None, False, None]
+    assert outcome(*apply(missed)) == "not switched"
+    short = [("gqn-adaptive+x", 0, [200, 150, 600], 5, "15000:3", 0.010)]
+    assert apply(short)[0][3].holds is False
+    # SM above the ceiling, or a return below either floor, fails once every seed has run
+    rougher = [probe_runs[0], (*probe_runs[1][:5], 0.0145)]  # (0.010 + 0.0145) / 2 = 0.01225 > 0.012
+    assert [clause.holds for clause in apply(rougher)[0]] == [False, True, True, True]
+    lower = [probe_runs[0], ("gqn-adaptive+x", 1, [200, 180, 690], 9, "15000:3 60000:9", 0.012)]  # 645 < 650
+    assert apply(lower)[0][1].holds is False

@@ -2,6 +2,10 @@
 
     python docs/results/decision_rules.py          # every rule: each clause with its figures, and the outcome
 
+R1 and R2 (:class:`Rule`) compare a candidate entry with the shipped one inside one table; R3 (:class:`ProbeRule`)
+reads a probe's own table (``docs/results/probes/...``, whose algorithm names are the runner's for the entry the
+probe patched) against bars taken from the main tables.
+
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
 still training has rows, but none at ``STEPS``). A clause is decided once the seeds it reads have run (gqn-adaptive's
@@ -167,16 +171,121 @@ def outcome(result: list[Clause], missing: dict[str, list[int]]) -> str:
     return "pending"
 
 
+@dataclass(frozen=True)
+class ProbeRule:
+    """Add a probe's setting to ``env``'s entry iff its gqn-adaptive runs on ``seeds`` meet fixed bars (R3).
+
+    :param probe_table: the probe's table (a folder under ``docs/results``); its runs carry the runner's name
+        ``agent`` of the entry the probe patched
+    :param smoothness_ceiling: ``(table, algo)`` whose mean final SM over ``seeds`` the probe's may not exceed
+    :param return_floors: ``(table, algo, margin)``: the probe's mean final return must reach that algorithm's
+        mean over ``seeds`` plus ``margin``, for each
+    """
+
+    name: str
+    probe_table: str
+    env: str
+    agent: str
+    seeds: list[int]
+    smoothness_ceiling: tuple[str, str]
+    return_floors: list[tuple[str, str, float]]
+
+    @property
+    def tables(self) -> list[str]:
+        """Every table the rule reads."""
+        return [self.probe_table, self.smoothness_ceiling[0], *(table for table, _, _ in self.return_floors)]
+
+
+PROBE_RULES = [
+    ProbeRule(
+        "R3",
+        "probes/newest_level_exploration/walker_residual_rate0.02",
+        "dm_control/walker-walk-v0",
+        "gqn-adaptive+residual+1update",
+        list(range(8)),
+        ("walker-walk_c0.1_100k_torso", "decqn-9+residual+1update"),
+        [("walker-walk_c0.1_100k", "sac", 0.0), ("walker-walk_c0.1_100k_torso", "gqn-adaptive+residual+1update", -50.0)],
+    )
+]
+
+
+def _seed_mean(table: pd.DataFrame, env: str, algo: str, seeds: list[int], column: str) -> float:
+    final = finished_runs(table, env)
+    return float(final[(final["algo"] == algo) & final["seed"].isin(seeds)][column].mean())
+
+
+def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[list[Clause], dict[str, list[int]]]:
+    """The probe rule's clauses on ``tables`` (by name) and the seeds still to run with the probe."""
+    probe = tables[rule.probe_table]
+    final = finished_runs(probe, rule.env)
+    runs = final[(final["algo"] == rule.agent) & final["seed"].isin(rule.seeds)]
+    done = sorted(runs["seed"].astype(int))
+    missing = {"gqn-adaptive": absent} if (absent := [seed for seed in rule.seeds if seed not in done]) else {}
+    complete = not missing
+    ceiling_table, ceiling_algo = rule.smoothness_ceiling
+    ceiling = _seed_mean(tables[ceiling_table], rule.env, ceiling_algo, rule.seeds, "smoothness")
+    smoothness = float(runs["smoothness"].mean())
+    floors = [
+        (
+            f"{algo} {_seed_mean(tables[table], rule.env, algo, rule.seeds, 'return'):.1f}{margin:+.0f}" if margin else algo,
+            _seed_mean(tables[table], rule.env, algo, rule.seeds, "return") + margin,
+        )
+        for table, algo, margin in rule.return_floors
+    ]
+    mean_return = float(runs["return"].mean())
+    misses = growth_misses(probe, rule.env, rule.agent.removeprefix("gqn-adaptive"), {"gqn-adaptive": done})
+    events = sum(
+        1 for check in growth_checks(probe[probe["env"] == rule.env]) if check.algo == rule.agent and check.seed in done
+    )
+    short = runs[runs["active_bins"].astype(int) < 9]
+    result = [
+        Clause(
+            f"the probe's mean final SM at most {ceiling_algo}'s on the same seeds",
+            f"{smoothness:.5f} vs {ceiling:.5f} over seeds {done}",
+            bool(smoothness <= ceiling) if complete else None,
+        ),
+        Clause(
+            "the probe's mean final return at least each floor",
+            f"{mean_return:.1f} over seeds {done}; floors: " + ", ".join(f"{name} = {value:.1f}" for name, value in floors),
+            bool(all(mean_return >= value for _, value in floors)) if complete else None,
+        ),
+        Clause(
+            "no growth of the probe's runs misses the collapse criterion",
+            f"{len(misses)} in {events} events ({'; '.join(misses) or 'none'})",
+            False if misses else (True if complete else None),
+        ),
+        Clause(
+            "every probe run reaches 9 bins",
+            f"{len(runs) - len(short)} of {len(runs)} finished runs at 9 bins"
+            + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
+            False if len(short) else (True if complete else None),
+        ),
+    ]
+    return result, missing
+
+
+def _print(name: str, header: str, result: list[Clause], missing: dict[str, list[int]]) -> None:
+    print(f"{name}: {header}: {outcome(result, missing)}")
+    for number, clause in enumerate(result, start=1):
+        verdict = {True: "holds", False: "FAILS", None: "open"}[clause.holds]
+        print(f"  {number}. {clause.text}: {verdict}\n     {clause.figures}")
+    if missing:
+        print("  still to run: " + ", ".join(f"{agent} {seeds}" for agent, seeds in missing.items()))
+
+
 def main() -> int:
     for rule in RULES:
         table = pd.read_csv(RESULTS / rule.table / "results.csv")
         result, missing = clauses(table, rule)
-        print(f"{rule.name}: {rule.env}, {rule.shipped} -> {rule.candidate}: {outcome(result, missing)}")
-        for number, clause in enumerate(result, start=1):
-            verdict = {True: "holds", False: "FAILS", None: "open"}[clause.holds]
-            print(f"  {number}. {clause.text}: {verdict}\n     {clause.figures}")
-        if missing:
-            print("  still to run: " + ", ".join(f"{agent} {seeds}" for agent, seeds in missing.items()))
+        _print(rule.name, f"{rule.env}, {rule.shipped} -> {rule.candidate}", result, missing)
+    for probe_rule in PROBE_RULES:
+        paths = {name: RESULTS / name / "results.csv" for name in probe_rule.tables}
+        if not paths[probe_rule.probe_table].exists():
+            print(f"{probe_rule.name}: {probe_rule.env}: pending (no run of the probe has finished)")
+            continue
+        tables = {name: pd.read_csv(path) for name, path in paths.items()}
+        result, missing = probe_clauses(tables, probe_rule)
+        _print(probe_rule.name, f"{probe_rule.env}, {probe_rule.agent} + {probe_rule.probe_table}", result, missing)
     return 0
 
 
