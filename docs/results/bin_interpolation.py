@@ -138,8 +138,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
     parser.add_argument("--only-new", action="store_true", help="skip the runs that already have rows in the CSV")
+    parser.add_argument(
+        "--out", type=Path, default=OUT, help="the CSV (default: bin_interpolation.csv; a probe's runs: its folder's)"
+    )
     args = parser.parse_args(argv)
-    rows = {(row["table"], row["algo"], row["env"], row["seed"], row["growth_step"]): row for row in _read(OUT)}
+    rows = {(row["table"], row["algo"], row["env"], row["seed"], row["growth_step"]): row for row in _read(args.out)}
     done = {key[:4] for key in rows}
     for run_dir, spec in finished_runs(args.tables, args.algos):
         if args.only_new and run_key(run_dir, spec) in done:
@@ -151,8 +154,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"{float(row['linear_bias']):+.3f}, error {float(row['linear_error']):.3f} | quadratic "
                 f"{float(row['quadratic_bias']):+.3f}, {float(row['quadratic_error']):.3f}"
             )
-    _write(OUT, rows, COLUMNS)
-    print(f"{OUT}: {len(rows)} rows")
+    _write(args.out, rows, COLUMNS)
+    print(f"{args.out}: {len(rows)} rows")
     return 0
 
 

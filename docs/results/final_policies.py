@@ -98,8 +98,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--algos", nargs="+", default=["gqn-adaptive", "gqn-linear", "decqn-9", "sac"])
     parser.add_argument("--tables", nargs="+", default=None, help="result folders under docs/results (default: all)")
     parser.add_argument("--only-new", action="store_true", help="skip the runs that already have rows in the CSV")
+    parser.add_argument(
+        "--out", type=Path, default=OUT, help="the CSV (default: final_policies.csv; a probe's runs: its folder's)"
+    )
     args = parser.parse_args(argv)
-    rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(OUT)}
+    rows = {(row["table"], row["algo"], row["env"], row["seed"]): row for row in _read(args.out)}
     for run_dir, spec in finished_runs(args.tables, args.algos):
         if args.only_new and run_key(run_dir, spec) in rows:
             continue
@@ -107,8 +110,8 @@ def main(argv: list[str] | None = None) -> int:
         rows[(str(row["table"]), str(row["algo"]), str(row["env"]), str(row["seed"]))] = row
         sm, extremes = float(row["smoothness"]), float(row["extreme_share"])
         print(f"{row['table']} {row['algo']} seed {row['seed']}: SM {sm:.4f}, extremes {extremes:.2f}")
-    _write(OUT, rows, COLUMNS)
-    print(f"{OUT}: {len(rows)} runs")
+    _write(args.out, rows, COLUMNS)
+    print(f"{args.out}: {len(rows)} runs")
     return 0
 
 
