@@ -149,16 +149,20 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
             False if too_many else (True if growth_done else None),
         )
     )
-    short = candidate[candidate["active_bins"].astype(int) < 9]
-    result.append(
-        Clause(
-            "every gqn-adaptive run with the candidate entry reaches 9 bins",
-            f"{len(candidate) - len(short)} of {len(candidate)} finished runs at 9 bins"
-            + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
-            False if len(short) else (True if adaptive_done else None),
-        )
-    )
+    result.append(nine_bins_clause("every gqn-adaptive run with the candidate entry reaches 9 bins", candidate, adaptive_done))
     return result, missing
+
+
+def nine_bins_clause(text: str, runs: pd.DataFrame, decided: bool) -> Clause:
+    """The clause that every one of ``runs`` (finished runs' final rows) ends at 9 bins: failed by any run short of
+    9, held once ``decided`` (every seed the clause reads has run), open otherwise."""
+    short = runs[runs["active_bins"].astype(int) < 9]
+    return Clause(
+        text,
+        f"{len(runs) - len(short)} of {len(runs)} finished runs at 9 bins"
+        + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
+        False if len(short) else (True if decided else None),
+    )
 
 
 def outcome(result: list[Clause], missing: dict[str, list[int]]) -> str:
@@ -237,7 +241,6 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
     events = sum(
         1 for check in growth_checks(probe[probe["env"] == rule.env]) if check.algo == rule.agent and check.seed in done
     )
-    short = runs[runs["active_bins"].astype(int) < 9]
     result = [
         Clause(
             f"the probe's mean final SM at most {ceiling_algo}'s on the same seeds",
@@ -254,12 +257,7 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
             f"{len(misses)} in {events} events ({'; '.join(misses) or 'none'})",
             False if misses else (True if complete else None),
         ),
-        Clause(
-            "every probe run reaches 9 bins",
-            f"{len(runs) - len(short)} of {len(runs)} finished runs at 9 bins"
-            + (f" (short: seeds {sorted(short['seed'].astype(int))})" if len(short) else ""),
-            False if len(short) else (True if complete else None),
-        ),
+        nine_bins_clause("every probe run reaches 9 bins", runs, complete),
     ]
     return result, missing
 
