@@ -16,8 +16,10 @@ Without ``PROBE_K`` in the environment it does nothing. Runs (from the repositor
 The committed ``<task>/results.csv`` files are those runs' tables at ``PROBE_RATE=0.1`` (walker, finger with the
 same algo, cartpole with ``gqn-adaptive``; seeds 0 and 1) and ``<task>_rate0.02/results.csv`` walker's, cartpole's
 and finger's at ``PROBE_RATE=0.02`` (walker's with seeds 0-5, the others 0 and 1; the runner's algo names,
-which here mean "with this probe"); the README
-(issue 11's section) and the closing note compare them with the shipped runs of the same seeds.
+which here mean "with this probe"); ``walker_residual_rate0.02/`` holds rule R3's runs (``docs/results/decision_rules.md``):
+``gqn-adaptive+residual+1update``, walker's entry since rule R1, at ``PROBE_RATE=0.02``, seeds 0-7, with the
+final-policy and bin-interpolation rows of the seeds whose models survived. The README (issue 11's section)
+compares them with the shipped runs of the same seeds.
 """
 
 import os
