@@ -262,8 +262,13 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
     return result, missing
 
 
-def _print(name: str, header: str, result: list[Clause], missing: dict[str, list[int]]) -> None:
-    print(f"{name}: {header}: {outcome(result, missing)}")
+def _print(
+    name: str, header: str, result: list[Clause], missing: dict[str, list[int]], words: dict[str, str] | None = None
+) -> None:
+    """Print a rule's outcome and clauses; ``words`` renames outcomes (a probe rule adopts a setting, it does not
+    switch an entry)."""
+    decided = outcome(result, missing)
+    print(f"{name}: {header}: {(words or {}).get(decided, decided)}")
     for number, clause in enumerate(result, start=1):
         verdict = {True: "holds", False: "FAILS", None: "open"}[clause.holds]
         print(f"  {number}. {clause.text}: {verdict}\n     {clause.figures}")
@@ -283,7 +288,8 @@ def main() -> int:
             continue
         tables = {name: pd.read_csv(path) for name, path in paths.items()}
         result, missing = probe_clauses(tables, probe_rule)
-        _print(probe_rule.name, f"{probe_rule.env}, {probe_rule.agent} + {probe_rule.probe_table}", result, missing)
+        header = f"{probe_rule.env}, {probe_rule.agent} + {probe_rule.probe_table}"
+        _print(probe_rule.name, header, result, missing, {"switch": "adopt", "not switched": "not adopted"})
     return 0
 
 
