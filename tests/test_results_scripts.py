@@ -12,6 +12,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "results"))
 
 from bin_interpolation import growth_step_errors, quadratic_weights
+from smoothness_at_matched_return import bootstrap_interval, matched_difference
 
 
 def test_quadratic_weights_are_the_lagrange_weights_of_the_nearest_three_coarse_bins():
@@ -215,3 +216,28 @@ def test_probe_rule_clauses_on_hand_made_tables():
     assert [clause.holds for clause in apply(rougher)[0]] == [False, True, True, True]
     lower = [probe_runs[0], ("gqn-adaptive+x", 1, [200, 180, 690], 9, "15000:3 60000:9", 0.012)]  # 645 < 650
     assert apply(lower)[0][1].holds is False
+
+
+def test_matched_difference_recovers_the_offset_of_exactly_linear_runs():
+    # SM = 0.01 + 1e-5 * task_return, plus 0.002 for agent x: x's runs at returns 100 and 300 (SM 0.013, 0.015),
+    # y's at 200 and 400 (0.012, 0.014). The raw mean difference is 0.014 - 0.013 = +0.001; at matched return +0.002.
+    return_x, sm_x = np.array([100.0, 300.0]), np.array([0.013, 0.015])
+    return_y, sm_y = np.array([200.0, 400.0]), np.array([0.012, 0.014])
+    offset, slope = matched_difference(return_x, sm_x, return_y, sm_y)
+    assert offset == pytest.approx(0.002)
+    assert slope == pytest.approx(1e-5)
+    # every determined bootstrap replicate of exactly linear runs has the same offset, if each run keeps its pair
+    low, high = bootstrap_interval(return_x, sm_x, return_y, sm_y, reps=200)
+    assert (low, high) == pytest.approx((0.002, 0.002))
+
+
+def test_matched_difference_is_the_within_agent_slope_fit():
+    # x: returns 0, 2 with SM 1, 1; y: returns 2, 4 with SM 0, 2. The common slope is the pooled within-agent one,
+    # sum (r - mean_r)(s - mean_s) / sum (r - mean_r)^2 = (0 + 0 + 1 + 1) / (1 + 1 + 1 + 1) = 0.5, and the offset
+    # (mean_s_x - mean_s_y) - slope (mean_r_x - mean_r_y) = (1 - 1) - 0.5 (1 - 3) = +1: equal raw means, but x
+    # is the rougher at the same task return.
+    offset, slope = matched_difference(np.array([0.0, 2.0]), np.array([1.0, 1.0]), np.array([2.0, 4.0]), np.array([0.0, 2.0]))
+    assert slope == pytest.approx(0.5)
+    assert offset == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="task returns that differ"):
+        matched_difference(np.array([5.0, 5.0]), np.array([1.0, 2.0]), np.array([5.0]), np.array([0.0]))
