@@ -241,3 +241,46 @@ def test_matched_difference_is_the_within_agent_slope_fit():
     assert offset == pytest.approx(1.0)
     with pytest.raises(ValueError, match="task returns that differ"):
         matched_difference(np.array([5.0, 5.0]), np.array([1.0, 2.0]), np.array([5.0]), np.array([0.0]))
+
+
+def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypatch):
+    import decision_rules
+    from decision_rules import Confirmation, Rule, clauses, confirmation_clauses, outcome
+
+    def table(runs: list[tuple[str, int, list[float], int, str, float]]) -> pd.DataFrame:
+        frame = _rule_table([run[:5] for run in runs])
+        final_smoothness = {(algo, seed): value for algo, seed, *_, value in runs}
+        frame["smoothness"] = [final_smoothness[(algo, seed)] for algo, seed in zip(frame["algo"], frame["seed"])]
+        return frame
+
+    check = Confirmation("C", "t", "E", "+x", [0], [1, 2], 392.0)
+    earlier = [("gqn-adaptive+x", 0, [0, 0, 600], 9, "15000:3", 0.012), ("decqn-9+x", 0, [0, 0, 500], 9, "", 0.010)]
+    # fresh seed 1: both agents finished (gqn-adaptive 400 > 392, its 2 -> 3 at 15k: 200 -> 150 holds);
+    # seed 2: gqn-adaptive only, so it does not count yet and nothing is decided
+    fresh = [
+        ("gqn-adaptive+x", 1, [200, 150, 400], 9, "15000:3", 0.014),
+        ("decqn-9+x", 1, [0, 0, 300], 9, "", 0.011),
+        ("gqn-adaptive+x", 2, [200, 100, 100], 5, "15000:3", 0.020),
+    ]
+    result, missing, lines = confirmation_clauses(table(earlier + fresh), check)
+    assert missing == {"both agents": [2]}
+    assert [clause.holds for clause in result] == [None, None, None]
+    assert result[0].figures.startswith("400.0 over seeds [1]")
+    assert result[2].figures.startswith("0 in 1 events")
+    assert outcome(result, missing) == "pending"
+    # SM: earlier seed 0.012 vs 0.010; fresh seed 0.014 vs 0.011; both (0.012 + 0.014) / 2 = 0.013 vs 0.0105
+    assert lines[0].startswith("SM, earlier seeds [0]: gqn-adaptive 0.01200 vs decqn-9 0.01000, +0.00200")
+    assert lines[1].startswith("SM, fresh seeds [1]: gqn-adaptive 0.01400 vs decqn-9 0.01100, +0.00300")
+    assert lines[2].startswith("SM, all counted seeds [0, 1]: gqn-adaptive 0.01300 vs decqn-9 0.01050, +0.00250")
+    # once decqn-9 finishes seed 2 it counts: (400 + 100) / 2 = 250 < 392 fails, the 5-bin run fails the 9 bins,
+    # and 200 -> 100 (below 70 % of 200) misses the collapse criterion
+    complete = table(earlier + fresh + [("decqn-9+x", 2, [0, 0, 300], 9, "", 0.011)])
+    result, missing, _ = confirmation_clauses(complete, check)
+    assert missing == {}
+    assert [clause.holds for clause in result] == [False, False, False]
+    assert outcome(result, missing) == "not switched"
+    # a rule decided on seed 0 does not read the fresh seeds: seed 2's 5 bins leave its 9-bins clause holding
+    monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0], "gqn-linear": [], "decqn-9": [0]})
+    old = [("gqn-adaptive+old", 0, [0, 0, 300], 9, "15000:3", 0.01), ("decqn-9+old", 0, [0, 0, 300], 9, "", 0.01)]
+    rule_result, _ = clauses(table(earlier + fresh + old), Rule("R", "t", "E", "+x", "+old", "none"))
+    assert rule_result[2].holds is True and rule_result[2].figures == "1 of 1 finished runs at 9 bins"

@@ -4,7 +4,8 @@
 
 R1 and R2 (:class:`Rule`) compare a candidate entry with the shipped one inside one table; R3 (:class:`ProbeRule`)
 reads a probe's own table (``docs/results/probes/...``, whose algorithm names are the runner's for the entry the
-probe patched) against bars taken from the main tables.
+probe patched) against bars taken from the main tables. C1 (:class:`Confirmation`) reads R1's clauses on fresh seeds
+of the entry R1 switched to, and reports the bar's SM item on the earlier seeds, the fresh ones and both.
 
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
@@ -108,7 +109,8 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
     # a clause is decided once the seeds it reads have run (the rule's outcome waits for every seed)
     adaptive_done = "gqn-adaptive" not in missing
     growth_done = not any(agent in missing for agent in GROWING_AGENTS)
-    candidate = final[final["algo"] == "gqn-adaptive" + rule.candidate]
+    # the rule's seeds only: later seeds of the same entry (C1's) do not enter a rule decided before them
+    candidate = final[(final["algo"] == "gqn-adaptive" + rule.candidate) & final["seed"].isin(RULE_SEEDS["gqn-adaptive"])]
     shipped = final[final["algo"] == "gqn-adaptive" + rule.shipped]
     seeds = sorted(set(candidate["seed"].astype(int)) & set(shipped["seed"].astype(int)))
     candidate_mean = candidate[candidate["seed"].isin(seeds)]["return"].mean()
@@ -262,6 +264,93 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
     return result, missing
 
 
+@dataclass(frozen=True)
+class Confirmation:
+    """A pre-stated extension of a table on fresh seeds (C1): R1's clauses read on those seeds, and the bar's SM item
+    reported on the table's earlier seeds, the fresh ones and both. A fresh seed counts once every one of ``agents``
+    has finished it with the entry ``suffix``.
+
+    :param return_threshold: gqn-adaptive's mean final return over the counted fresh seeds must exceed it (R1's)
+    """
+
+    name: str
+    table: str
+    env: str
+    suffix: str
+    earlier_seeds: list[int]
+    fresh_seeds: list[int]
+    return_threshold: float
+    agents: tuple[str, str] = ("gqn-adaptive", "decqn-9")
+
+
+CONFIRMATIONS = [
+    Confirmation(
+        "C1",
+        "walker-walk_c0.1_100k_torso",
+        "dm_control/walker-walk-v0",
+        "+residual+1update",
+        list(range(8)),
+        [8, 9, 10, 11],
+        392.0,
+    )
+]
+
+
+def counted_seeds(final: pd.DataFrame, confirmation: Confirmation) -> list[int]:
+    """The fresh seeds that every agent of ``confirmation`` has finished (``final``: finished runs' last rows)."""
+    done = [set(final.loc[final["algo"] == agent + confirmation.suffix, "seed"].astype(int)) for agent in confirmation.agents]
+    return sorted(set(confirmation.fresh_seeds).intersection(*done))
+
+
+def confirmation_clauses(
+    table: pd.DataFrame, confirmation: Confirmation
+) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
+    """R1's clauses on the counted fresh seeds, the fresh seeds not yet counted, and the SM lines to report."""
+    from sb3_gqn.significance import difference_interval, mean_difference
+
+    final = finished_runs(table, confirmation.env)
+    counted = counted_seeds(final, confirmation)
+    missing = {"both agents": absent} if (absent := [s for s in confirmation.fresh_seeds if s not in counted]) else {}
+    complete = not missing
+    agent, baseline = (name + confirmation.suffix for name in confirmation.agents)
+    fresh = final[(final["algo"] == agent) & final["seed"].isin(counted)]
+    mean_return = float(fresh["return"].mean())
+    misses = growth_misses(table, confirmation.env, confirmation.suffix, {"gqn-adaptive": counted})
+    events = sum(
+        1 for check in growth_checks(table[table["env"] == confirmation.env]) if check.algo == agent and check.seed in counted
+    )
+    result = [
+        Clause(
+            f"gqn-adaptive's mean final return over the fresh seeds above {confirmation.return_threshold:.0f}",
+            f"{mean_return:.1f} over seeds {counted} (" + ", ".join(f"{value:.0f}" for value in fresh["return"]) + ")",
+            bool(mean_return > confirmation.return_threshold) if complete else None,
+        ),
+        nine_bins_clause("every gqn-adaptive run on the fresh seeds reaches 9 bins", fresh, complete),
+        Clause(
+            "no gqn-adaptive growth on the fresh seeds misses the collapse criterion",
+            f"{len(misses)} in {events} events ({'; '.join(misses) or 'none'})",
+            False if misses else (True if complete else None),
+        ),
+    ]
+    lines = []
+    for label, seeds in [
+        ("earlier seeds", confirmation.earlier_seeds),
+        ("fresh seeds", counted),
+        ("all counted seeds", confirmation.earlier_seeds + counted if counted else []),
+    ]:
+        values = [
+            final[(final["algo"] == name) & final["seed"].isin(seeds)]["smoothness"].to_numpy() for name in (agent, baseline)
+        ]
+        if min(len(v) for v in values) == 0:
+            continue
+        difference, (low, high) = difference_interval(mean_difference, *values)
+        lines.append(
+            f"SM, {label} {seeds}: {confirmation.agents[0]} {values[0].mean():.5f} vs {confirmation.agents[1]} "
+            f"{values[1].mean():.5f}, {difference:+.5f} [{low:+.5f}, {high:+.5f}]"
+        )
+    return result, missing, lines
+
+
 def _print(
     name: str, header: str, result: list[Clause], missing: dict[str, list[int]], words: dict[str, str] | None = None
 ) -> None:
@@ -290,6 +379,13 @@ def main() -> int:
         result, missing = probe_clauses(tables, probe_rule)
         header = f"{probe_rule.env}, {probe_rule.agent} + {probe_rule.probe_table}"
         _print(probe_rule.name, header, result, missing, {"switch": "adopt", "not switched": "not adopted"})
+    for confirmation in CONFIRMATIONS:
+        table = pd.read_csv(RESULTS / confirmation.table / "results.csv")
+        result, missing, lines = confirmation_clauses(table, confirmation)
+        header = f"{confirmation.env}, {confirmation.suffix} on fresh seeds {confirmation.fresh_seeds} (R1's clauses)"
+        _print(confirmation.name, header, result, missing, {"switch": "R1 confirmed", "not switched": "R1 not confirmed"})
+        for line in lines:
+            print(f"  {line}")
     return 0
 
 
