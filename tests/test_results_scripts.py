@@ -82,6 +82,14 @@ def _rule_table(runs: list[tuple[str, int, list[float], int, str]]) -> pd.DataFr
     return pd.DataFrame(rows)
 
 
+def _rule_table_with_smoothness(runs: list[tuple[str, int, list[float], int, str, float]]) -> pd.DataFrame:
+    """``_rule_table`` of ``(algo, seed, returns, final bins, growth_events, SM)``, each run's SM on all its rows."""
+    frame = _rule_table([run[:5] for run in runs])
+    final_smoothness = {(algo, seed): value for algo, seed, *_, value in runs}
+    frame["smoothness"] = [final_smoothness[(algo, seed)] for algo, seed in zip(frame["algo"], frame["seed"])]
+    return frame
+
+
 def test_decision_rule_clauses_on_a_hand_made_table(monkeypatch):
     import decision_rules
     from decision_rules import Rule, clauses, outcome
@@ -162,18 +170,12 @@ def test_evaluation_drops_count_pairs_after_the_last_growth_only():
 def test_probe_rule_clauses_on_hand_made_tables():
     from decision_rules import ProbeRule, outcome, probe_clauses
 
-    def table(runs: list[tuple[str, int, list[float], int, str, float]]) -> pd.DataFrame:
-        frame = _rule_table([run[:5] for run in runs])
-        final_smoothness = {(algo, seed): value for algo, seed, *_, value in runs}
-        frame["smoothness"] = [final_smoothness[(algo, seed)] for algo, seed in zip(frame["algo"], frame["seed"])]
-        return frame
-
     rule = ProbeRule(
         "R", "P", "E", "gqn-adaptive+x", [0, 1], ("T", "decqn-9+x"), [("S", "sac", 0.0), ("T", "gqn-adaptive+x", -50.0)]
     )
     # bars: decqn-9's SM (0.011 + 0.013) / 2 = 0.012; SAC's return (500 + 600) / 2 = 550; the shipped entry's
     # (700 + 700) / 2 - 50 = 650
-    ceiling_and_floor = table(
+    ceiling_and_floor = _rule_table_with_smoothness(
         [
             ("decqn-9+x", 0, [0, 0, 400], 9, "", 0.011),
             ("decqn-9+x", 1, [0, 0, 400], 9, "", 0.013),
@@ -181,7 +183,7 @@ def test_probe_rule_clauses_on_hand_made_tables():
             ("gqn-adaptive+x", 1, [0, 0, 700], 9, "", 0.02),
         ]
     )
-    sac = table([("sac", 0, [0, 0, 500], 0, "", 0.005), ("sac", 1, [0, 0, 600], 0, "", 0.005)])
+    sac = _rule_table_with_smoothness([("sac", 0, [0, 0, 500], 0, "", 0.005), ("sac", 1, [0, 0, 600], 0, "", 0.005)])
     # the probe: finals 600 and 700 (mean 650, exactly the floor), SM 0.010 and 0.012 (mean 0.011); growths at 15k
     # (200 -> 150 and 200 -> 180, both at least 70 % of 200) and at 60k (judged 20k -> 100k: 150 -> 600, 180 -> 700)
     probe_runs = [
@@ -190,7 +192,7 @@ def test_probe_rule_clauses_on_hand_made_tables():
     ]
 
     def apply(runs: list) -> tuple[list, dict]:
-        return probe_clauses({"P": table(runs), "T": ceiling_and_floor, "S": sac}, rule)
+        return probe_clauses({"P": _rule_table_with_smoothness(runs), "T": ceiling_and_floor, "S": sac}, rule)
 
     result, missing = apply(probe_runs)
     assert missing == {}
@@ -247,12 +249,6 @@ def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypat
     import decision_rules
     from decision_rules import Confirmation, Rule, clauses, confirmation_clauses, outcome
 
-    def table(runs: list[tuple[str, int, list[float], int, str, float]]) -> pd.DataFrame:
-        frame = _rule_table([run[:5] for run in runs])
-        final_smoothness = {(algo, seed): value for algo, seed, *_, value in runs}
-        frame["smoothness"] = [final_smoothness[(algo, seed)] for algo, seed in zip(frame["algo"], frame["seed"])]
-        return frame
-
     check = Confirmation("C", "t", "E", "+x", [0], [1, 2], 392.0)
     earlier = [("gqn-adaptive+x", 0, [0, 0, 600], 9, "15000:3", 0.012), ("decqn-9+x", 0, [0, 0, 500], 9, "", 0.010)]
     # fresh seed 1: both agents finished (gqn-adaptive 400 > 392, its 2 -> 3 at 15k: 200 -> 150 holds);
@@ -262,7 +258,7 @@ def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypat
         ("decqn-9+x", 1, [0, 0, 300], 9, "", 0.011),
         ("gqn-adaptive+x", 2, [200, 100, 100], 5, "15000:3", 0.020),
     ]
-    result, missing, lines = confirmation_clauses(table(earlier + fresh), check)
+    result, missing, lines = confirmation_clauses(_rule_table_with_smoothness(earlier + fresh), check)
     assert missing == {"both agents": [2]}
     assert [clause.holds for clause in result] == [None, None, None]
     assert result[0].figures.startswith("400.0 over seeds [1]")
@@ -274,7 +270,7 @@ def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypat
     assert lines[2].startswith("SM, all counted seeds [0, 1]: gqn-adaptive 0.01300 vs decqn-9 0.01050, +0.00250")
     # once decqn-9 finishes seed 2 it counts: (400 + 100) / 2 = 250 < 392 fails, the 5-bin run fails the 9 bins,
     # and 200 -> 100 (below 70 % of 200) misses the collapse criterion
-    complete = table(earlier + fresh + [("decqn-9+x", 2, [0, 0, 300], 9, "", 0.011)])
+    complete = _rule_table_with_smoothness(earlier + fresh + [("decqn-9+x", 2, [0, 0, 300], 9, "", 0.011)])
     result, missing, _ = confirmation_clauses(complete, check)
     assert missing == {}
     assert [clause.holds for clause in result] == [False, False, False]
@@ -282,5 +278,5 @@ def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypat
     # a rule decided on seed 0 does not read the fresh seeds: seed 2's 5 bins leave its 9-bins clause holding
     monkeypatch.setattr(decision_rules, "RULE_SEEDS", {"gqn-adaptive": [0], "gqn-linear": [], "decqn-9": [0]})
     old = [("gqn-adaptive+old", 0, [0, 0, 300], 9, "15000:3", 0.01), ("decqn-9+old", 0, [0, 0, 300], 9, "", 0.01)]
-    rule_result, _ = clauses(table(earlier + fresh + old), Rule("R", "t", "E", "+x", "+old", "none"))
+    rule_result, _ = clauses(_rule_table_with_smoothness(earlier + fresh + old), Rule("R", "t", "E", "+x", "+old", "none"))
     assert rule_result[2].holds is True and rule_result[2].figures == "1 of 1 finished runs at 9 bins"

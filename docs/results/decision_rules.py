@@ -102,6 +102,11 @@ def growth_misses(table: pd.DataFrame, env: str, suffix: str, seeds_of: dict[str
     return misses
 
 
+def growth_events(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> int:
+    """How many growth events the runs of ``algo`` on ``env`` with ``seeds`` have (what the miss counts are out of)."""
+    return sum(1 for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds)
+
+
 def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, list[int]]]:
     """The rule's clauses on ``table`` and the seeds still to run with the candidate entry."""
     final = finished_runs(table, rule.env)
@@ -128,12 +133,7 @@ def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, li
         for agent in GROWING_AGENTS
     }
     candidate_misses = growth_misses(table, rule.env, rule.candidate, done_seeds)
-    events = sum(
-        1
-        for check in growth_checks(table[table["env"] == rule.env])
-        for agent in GROWING_AGENTS
-        if check.algo == agent + rule.candidate and check.seed in done_seeds[agent]
-    )
+    events = sum(growth_events(table, rule.env, agent + rule.candidate, done_seeds[agent]) for agent in GROWING_AGENTS)
     if rule.misses == "none":
         allowed, against = 0, "none allowed"
     else:
@@ -240,9 +240,7 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
     ]
     mean_return = float(runs["return"].mean())
     misses = growth_misses(probe, rule.env, rule.agent.removeprefix("gqn-adaptive"), {"gqn-adaptive": done})
-    events = sum(
-        1 for check in growth_checks(probe[probe["env"] == rule.env]) if check.algo == rule.agent and check.seed in done
-    )
+    events = growth_events(probe, rule.env, rule.agent, done)
     result = [
         Clause(
             f"the probe's mean final SM at most {ceiling_algo}'s on the same seeds",
@@ -316,9 +314,7 @@ def confirmation_clauses(
     fresh = final[(final["algo"] == agent) & final["seed"].isin(counted)]
     mean_return = float(fresh["return"].mean())
     misses = growth_misses(table, confirmation.env, confirmation.suffix, {"gqn-adaptive": counted})
-    events = sum(
-        1 for check in growth_checks(table[table["env"] == confirmation.env]) if check.algo == agent and check.seed in counted
-    )
+    events = growth_events(table, confirmation.env, agent, counted)
     result = [
         Clause(
             f"gqn-adaptive's mean final return over the fresh seeds above {confirmation.return_threshold:.0f}",
