@@ -156,21 +156,32 @@ def final_rows(table: pd.DataFrame) -> pd.DataFrame:
     return table[table["step"] == last]
 
 
-def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
-    """Final returns min-max normalized per task (env, penalty) over all of that task's runs, as rliable wants
-    them: ``{algo: array (runs, tasks)}`` (runs cut to the algorithm's smallest seed count) and the tasks."""
+def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarray]], list[tuple[str, float]]]:
+    """Final returns min-max normalized per task (env, penalty) over all of that task's runs: ``{algo: [runs of
+    each task]}`` (every run, counts may differ between tasks) and the tasks."""
     final = final_rows(table).copy()
     task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
     final = final.join(task_range, on=["env", "penalty"])
     spread = (final["max"] - final["min"]).replace(0.0, 1.0)
     final["normalized"] = (final["return"] - final["min"]) / spread
+    final = final.sort_values("seed", kind="stable")  # lowest seeds first, so a cut keeps the same seeds everywhere
     tasks = sorted(set(zip(final["env"], final["penalty"])))
+    runs_by_algo = {
+        str(algo): [runs[(runs["env"] == env) & (runs["penalty"] == c)]["normalized"].to_numpy() for env, c in tasks]
+        for algo, runs in final.groupby("algo")
+    }
+    return runs_by_algo, tasks
+
+
+def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
+    """:func:`normalized_final_runs` as rliable wants them: ``{algo: array (runs, tasks)}`` (runs cut to the
+    algorithm's smallest seed count, keeping the lowest seeds) and the tasks."""
+    runs_by_algo, tasks = normalized_final_runs(table)
     scores: dict[str, np.ndarray] = {}
-    for algo, runs in final.groupby("algo"):
-        per_task = [runs[(runs["env"] == env) & (runs["penalty"] == c)]["normalized"].to_numpy() for env, c in tasks]
+    for algo, per_task in runs_by_algo.items():
         n_runs = min(len(values) for values in per_task)
         if n_runs:
-            scores[str(algo)] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
+            scores[algo] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
     return scores, tasks
 
 

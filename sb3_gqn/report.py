@@ -31,11 +31,18 @@ import numpy as np
 import pandas as pd
 
 from sb3_gqn.benchmark import warm_started
-from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores, run_growth_events
+from sb3_gqn.plots import (
+    final_rows,
+    iqm_with_intervals,
+    normalized_final_runs,
+    normalized_final_scores,
+    run_growth_events,
+)
 from sb3_gqn.significance import (
     difference_interval,
     iqm_difference,
     mean_difference,
+    pooled_iqm_interval,
     probability_of_improvement,
     seeds_to_resolve,
 )
@@ -291,17 +298,29 @@ def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str
     scores, tasks = normalized_final_scores(table)
     if len(tasks) > 1 and scores:
         estimates, intervals = iqm_with_intervals(scores, reps)
-        rows = [
-            {
+        every_run = normalized_final_runs(table)[0]
+        # where some task has more runs than the cut keeps, also say what all of them give (same normalization)
+        uneven = any(len({len(runs) for runs in every_run[algo]}) > 1 for algo in scores)
+        rows = []
+        for algo in sorted(scores, key=lambda algo: -float(estimates[algo][0])):
+            row = {
                 "algo": algo,
                 "runs per task": int(scores[algo].shape[0]),
                 "IQM": float(estimates[algo][0]),
                 "95 % CI": f"[{intervals[algo][0, 0]:.2f}, {intervals[algo][1, 0]:.2f}]",
             }
-            for algo in sorted(scores, key=lambda algo: -float(estimates[algo][0]))
-        ]
+            if uneven:
+                pooled, (low, high) = pooled_iqm_interval(every_run[algo], reps)
+                row["every run: runs per task"] = " / ".join(str(len(runs)) for runs in every_run[algo])
+                row["every run: IQM (95 % CI)"] = f"{pooled:.2f} [{low:.2f}, {high:.2f}]"
+            rows.append(row)
         names = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks)
         heading = f"IQM of min-max normalized final return across {len(tasks)} tasks ({names})"
+        if uneven:
+            heading += (
+                "; IQM: each agent's lowest seeds, as many on every task; every run: all of them pooled "
+                "(the bootstrap resamples within each task)"
+            )
         sections["iqm"] = Section(heading, _markdown(pd.DataFrame(rows)))
     if pairs:
         sections.update(comparison_sections(table, pairs, reps))

@@ -95,6 +95,29 @@ def difference_interval(
     return float(estimates["pair"][0]), (float(intervals["pair"][0, 0]), float(intervals["pair"][1, 0]))
 
 
+def pooled_iqm(per_task: list[np.ndarray]) -> float:
+    """IQM of every run of every task pooled, for tasks with unequal run counts: the mean of the middle half of all
+    scores (``scipy.stats.trim_mean(..., 0.25)``, rliable's ``aggregate_iqm`` on the flattened scores).
+
+    ``[[0, 1, 2, 3, 4, 5], [6, 7]]``: 8 scores, 2 cut at each end, so the mean of 2, 3, 4, 5 = 3.5.
+    """
+    from scipy.stats import trim_mean
+
+    return float(trim_mean(np.concatenate([np.ravel(runs) for runs in per_task]), 0.25))
+
+
+def pooled_iqm_interval(per_task: list[np.ndarray], reps: int = 2000, seed: int = 0) -> tuple[float, tuple[float, float]]:
+    """:func:`pooled_iqm` and its 95 % percentile bootstrap interval, resampling each task's runs with replacement
+    within the task (stratified, as rliable's bootstrap; each task keeps its run count); ``seed`` fixes the draws."""
+    per_task = [np.ravel(np.asarray(runs, dtype=np.float64)) for runs in per_task]
+    if min(len(runs) for runs in per_task) < 1:
+        raise ValueError("pooled_iqm_interval needs at least one run on every task")
+    rng = np.random.default_rng(seed)
+    replicates = [pooled_iqm([rng.choice(runs, size=len(runs)) for runs in per_task]) for _ in range(reps)]
+    low, high = np.percentile(replicates, [2.5, 97.5])
+    return pooled_iqm(per_task), (float(low), float(high))
+
+
 def seeds_to_resolve(values_x: np.ndarray, values_y: np.ndarray, alpha: float = 0.05, power: float = 0.8) -> float:
     """Seeds per agent for a two-sided two-sample test at level ``alpha`` to detect the observed difference of
     means with probability ``power``: ``2 (z_(1 - alpha/2) + z_power)^2 s^2 / d^2``, rounded up (at least 2), with

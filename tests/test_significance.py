@@ -13,6 +13,8 @@ from sb3_gqn.significance import (
     difference_interval,
     iqm_difference,
     mean_difference,
+    pooled_iqm,
+    pooled_iqm_interval,
     probability_of_improvement,
     seeds_to_resolve,
 )
@@ -56,6 +58,26 @@ def test_difference_interval_brackets_the_estimate_within_what_resampling_can_re
     assert one_run == pytest.approx(7.0 - 17.0) and math.isnan(low) and math.isnan(high)
     with pytest.raises(ValueError, match="same tasks"):
         difference_interval(iqm_difference, np.zeros((3, 2)), np.zeros((3, 3)))
+
+
+def test_pooled_iqm_trims_a_quarter_of_every_run_of_every_task_pooled():
+    # 8 scores over two tasks of 6 and 2 runs: 0 and 1, 6 and 7 cut, mean(2, 3, 4, 5) = 3.5
+    assert pooled_iqm([np.arange(6.0), np.array([6.0, 7.0])]) == pytest.approx(3.5)
+    # 9 scores: int(0.25 * 9) = 2 cut at each end (scipy's and rliable's rule, no fractional weights), mean(2..6)
+    assert pooled_iqm([np.arange(6.0), np.array([6.0, 7.0]), np.array([8.0])]) == pytest.approx(4.0)
+
+
+def test_pooled_iqm_interval_resamples_within_each_task():
+    # task one's single run (0) is in every replicate exactly once; task two's three runs all equal 1: every
+    # replicate pools [0, 1, 1, 1] and its IQM (cut 1 at each end) is 1, so the interval cannot move. A bootstrap
+    # that resampled the four scores together would draw 0 more than once in some replicates (IQM 0.5 or 0).
+    value, (low, high) = pooled_iqm_interval([np.array([0.0]), np.ones(3)], reps=300)
+    assert value == low == high == pytest.approx(1.0)
+    spread = pooled_iqm_interval([np.arange(4.0), np.arange(4.0, 8.0)], reps=300)
+    assert spread[1][0] < spread[0] < spread[1][1]
+    assert pooled_iqm_interval([np.arange(4.0), np.arange(4.0, 8.0)], reps=300) == spread  # seeded
+    with pytest.raises(ValueError, match="every task"):
+        pooled_iqm_interval([np.arange(4.0), np.array([])])
 
 
 def test_seeds_to_resolve_hand_values():
@@ -118,6 +140,21 @@ def test_report_states_each_comparison_with_its_interval():
     row_c = next(line for line in per_task if "a vs c" in line)
     assert "| 3 / 1 | +15 | - |" in row_c  # one run of c: no interval, no seed count
     assert "comparison_tasks" not in report_sections(_two_task_table(), reps=50)
+
+
+def test_iqm_table_keeps_the_lowest_seeds_and_pools_every_run_where_counts_differ():
+    table = _two_task_table()
+    assert "every run" not in report_sections(table, reps=50)["iqm"].body  # a and b have 3 runs on each task
+    # a fourth run of a on task two, listed first: the cut table still keeps a's seeds 0-2 there
+    table = pd.concat([pd.DataFrame([_final("a", "two", 3, 0.0, 0.01)]), table], ignore_index=True)
+    iqm = report_sections(table, reps=50)["iqm"]
+    # task one normalized over 0..30 (c's 5 included): a = 1/3, 2/3, 1; task two over 0..300: a's seeds 0-2 = 1,
+    # 1/3, 2/3 and seed 3 = 0. Cut to seeds 0-2: 6 scores, 1 off each end -> (1/3 + 2/3 + 2/3 + 1) / 4 = 0.67
+    # (keeping the first-listed seeds 3, 0, 1 instead would give (1/3 + 1/3 + 2/3 + 2/3) / 4 = 0.5). Every run:
+    # 7 scores, 1 off each end -> (1/3 + 1/3 + 2/3 + 2/3 + 1) / 5 = 0.6
+    row_a = next(line for line in iqm.body.splitlines() if line.startswith("| a |"))
+    assert "| 3 | 0.67 |" in row_a and "| 3 / 4 | 0.60 [" in row_a
+    assert "every run: all of them pooled" in iqm.heading
 
 
 def test_compare_option_rejects_bad_pairs_and_unknown_algorithms(tmp_path, capsys):
