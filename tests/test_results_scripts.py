@@ -280,3 +280,39 @@ def test_confirmation_counts_a_fresh_seed_once_both_agents_finished_it(monkeypat
     old = [("gqn-adaptive+old", 0, [0, 0, 300], 9, "15000:3", 0.01), ("decqn-9+old", 0, [0, 0, 300], 9, "", 0.01)]
     rule_result, _ = clauses(_rule_table_with_smoothness(earlier + fresh + old), Rule("R", "t", "E", "+x", "+old", "none"))
     assert rule_result[2].holds is True and rule_result[2].figures == "1 of 1 finished runs at 9 bins"
+
+
+def test_seed_fill_compares_matched_seeds_and_decides_the_walker_item_once_every_fresh_seed_ran():
+    from decision_rules import SeedFill, outcome, seed_fill_lines
+
+    fill = SeedFill("C", "E", "a", "gqn-adaptive+x", "b", "sac", [0, 1], [2, 3], item=True)
+    agent = _rule_table_with_smoothness(
+        [
+            ("gqn-adaptive+x", seed, [0, 0, value], 9, "", sm)
+            for seed, value, sm in [(0, 600, 0.012), (1, 400, 0.010), (2, 500, 0.014), (3, 300, 0.012)]
+        ]
+    )
+    # SAC: seeds 0-2 finished (300, 200, 700); seed 3 still training (no row at 100k), so it does not count yet
+    baseline = _rule_table_with_smoothness(
+        [("sac", seed, [0, 0, value], 9, "", 0.005) for seed, value in [(0, 300), (1, 200), (2, 700), (3, 900)]]
+    )
+    baseline = baseline[~((baseline["seed"] == 3) & (baseline["step"] == 100_000))]
+    result, missing, lines = seed_fill_lines({"a": agent, "b": baseline}, fill)
+    assert missing == {"sac": [3]}
+    # earlier seeds: (600 + 400) / 2 = 500 vs 250; fresh seed 2: 500 vs 700; both: 500 vs 400
+    assert lines[0].startswith("earlier seeds [0, 1]: return 500.0 vs 250.0, +250 [")
+    assert "SM 0.01100 vs 0.00500, +0.00600 [" in lines[0]
+    assert lines[1].startswith("fresh seeds [2]: return 500.0 vs 700.0, -200")
+    assert lines[2].startswith("all counted seeds [0, 1, 2]: return 500.0 vs 400.0, +100 [")
+    assert result[0].holds is None and outcome(result, missing) == "pending"
+    # SAC's seed 3 finishes at 900: (600 + 400 + 500 + 300) / 4 = 450 vs 525 over 0-3, so the item fails
+    finished = _rule_table_with_smoothness(
+        [("sac", seed, [0, 0, value], 9, "", 0.005) for seed, value in [(0, 300), (1, 200), (2, 700), (3, 900)]]
+    )
+    result, missing, lines = seed_fill_lines({"a": agent, "b": finished}, fill)
+    assert missing == {} and result[0].figures == "450.0 vs 525.0 over seeds [0, 1, 2, 3]"
+    assert outcome(result, missing) == "not switched"  # printed as "item fails"
+    # a fill that only reports has no clause
+    assert (
+        seed_fill_lines({"a": agent, "b": finished}, SeedFill("C", "E", "a", "gqn-adaptive+x", "b", "sac", [0], [1]))[0] == []
+    )

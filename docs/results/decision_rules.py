@@ -5,7 +5,9 @@
 R1 and R2 (:class:`Rule`) compare a candidate entry with the shipped one inside one table; R3 (:class:`ProbeRule`)
 reads a probe's own table (``docs/results/probes/...``, whose algorithm names are the runner's for the entry the
 probe patched) against bars taken from the main tables. C1 (:class:`Confirmation`) reads R1's clauses on fresh seeds
-of the entry R1 switched to, and reports the bar's SM item on the earlier seeds, the fresh ones and both.
+of the entry R1 switched to, and reports the bar's SM item on the earlier seeds, the fresh ones and both. C2 and C3
+(:class:`SeedFill`) compare gqn-adaptive's shipped entry with SAC on matched seeds as SAC's fresh seeds finish; C2
+decides the bar's walker item on them.
 
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
@@ -347,6 +349,104 @@ def confirmation_clauses(
     return result, missing, lines
 
 
+@dataclass(frozen=True)
+class SeedFill:
+    """A pre-stated fill of a baseline's seeds (C2, C3): the agent's shipped entry against the baseline, final return
+    and SM, on the matched earlier seeds, the fresh ones the baseline has finished, and both. A fresh seed counts once
+    both have finished it.
+
+    :param item: C2's clause: the agent's mean final return over every counted seed at least the baseline's (the
+        bar's walker item); ``False`` where the fill only reports (C3)
+    """
+
+    name: str
+    env: str
+    agent_table: str
+    agent: str
+    baseline_table: str
+    baseline: str
+    earlier_seeds: list[int]
+    fresh_seeds: list[int]
+    item: bool = False
+
+
+SEED_FILLS = [
+    SeedFill(
+        "C2",
+        "dm_control/walker-walk-v0",
+        "walker-walk_c0.1_100k_torso",
+        "gqn-adaptive+residual+1update",
+        "walker-walk_c0.1_100k",
+        "sac",
+        list(range(8)),
+        [8, 9, 10, 11],
+        item=True,
+    ),
+    SeedFill(
+        "C3",
+        "dm_control/finger-spin-v0",
+        "finger-spin_c0.1_100k",
+        "gqn-adaptive+layernorm+1update",
+        "finger-spin_c0.1_100k",
+        "sac",
+        list(range(4)),
+        [4, 5, 6, 7],
+    ),
+    SeedFill(
+        "C3",
+        "dm_control/cartpole-swingup-v0",
+        "cartpole-swingup_c0.1_100k",
+        "gqn-adaptive",
+        "cartpole-swingup_c0.1_100k",
+        "sac",
+        list(range(2)),
+        [2, 3, 4, 5, 6, 7],
+    ),
+]
+
+
+def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
+    """C2's item (empty for a fill that only reports), the fresh seeds not yet counted, and the comparison lines."""
+    from sb3_gqn.significance import difference_interval, mean_difference
+
+    agent = finished_runs(tables[fill.agent_table], fill.env)
+    agent = agent[agent["algo"] == fill.agent]
+    baseline = finished_runs(tables[fill.baseline_table], fill.env)
+    baseline = baseline[baseline["algo"] == fill.baseline]
+    done = set(agent["seed"].astype(int)) & set(baseline["seed"].astype(int))
+    counted = [seed for seed in fill.fresh_seeds if seed in done]
+    missing = {fill.baseline: absent} if (absent := [s for s in fill.fresh_seeds if s not in done]) else {}
+    every = [seed for seed in fill.earlier_seeds if seed in done] + counted
+    lines = []
+    groups = [("earlier seeds", fill.earlier_seeds)] + (
+        [("fresh seeds", counted), ("all counted seeds", every)] if counted else []
+    )
+    for label, seeds in groups:
+        pair = [runs[runs["seed"].isin(seeds)] for runs in (agent, baseline)]
+        if not seeds or min(len(runs) for runs in pair) == 0:
+            continue
+        parts = []
+        for column, spec, interval in [("return", ".1f", "+.0f"), ("smoothness", ".5f", "+.5f")]:
+            values = [runs[column].to_numpy() for runs in pair]
+            difference, (low, high) = difference_interval(mean_difference, *values)
+            parts.append(
+                f"{'return' if column == 'return' else 'SM'} {values[0].mean():{spec}} vs {values[1].mean():{spec}}, "
+                f"{difference:{interval}} [{low:{interval}}, {high:{interval}}]"
+            )
+        lines.append(f"{label} {seeds}: " + "; ".join(parts))
+    result = []
+    if fill.item:
+        pair = [runs[runs["seed"].isin(every)]["return"] for runs in (agent, baseline)]
+        result.append(
+            Clause(
+                f"{fill.agent}'s mean final return over every counted seed at least {fill.baseline}'s",
+                f"{pair[0].mean():.1f} vs {pair[1].mean():.1f} over seeds {every}",
+                bool(pair[0].mean() >= pair[1].mean()) if not missing else None,
+            )
+        )
+    return result, missing, lines
+
+
 def _print(
     name: str, header: str, result: list[Clause], missing: dict[str, list[int]], words: dict[str, str] | None = None
 ) -> None:
@@ -380,6 +480,19 @@ def main() -> int:
         result, missing, lines = confirmation_clauses(table, confirmation)
         header = f"{confirmation.env}, {confirmation.suffix} on fresh seeds {confirmation.fresh_seeds} (R1's clauses)"
         _print(confirmation.name, header, result, missing, {"switch": "R1 confirmed", "not switched": "R1 not confirmed"})
+        for line in lines:
+            print(f"  {line}")
+    for fill in SEED_FILLS:
+        tables = {name: pd.read_csv(RESULTS / name / "results.csv") for name in {fill.agent_table, fill.baseline_table}}
+        result, missing, lines = seed_fill_lines(tables, fill)
+        header = f"{fill.env}, {fill.agent} vs {fill.baseline} on matched seeds (fresh: {fill.fresh_seeds})"
+        if fill.item:
+            _print(fill.name, header, result, missing, {"switch": "item holds", "not switched": "item fails"})
+        else:
+            state = "reported" if not missing else "pending"
+            print(f"{fill.name}: {header}: {state}")
+            if missing:
+                print("  still to run: " + ", ".join(f"{agent} {seeds}" for agent, seeds in missing.items()))
         for line in lines:
             print(f"  {line}")
     return 0
