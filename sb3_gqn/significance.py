@@ -7,6 +7,7 @@ its uncertainty, so that a table says not only which agent reads higher but whet
 * :func:`iqm_difference` and :func:`probability_of_improvement` across tasks, on min-max normalized final returns
   (rliable's definitions: Agarwal et al., 2021);
 * :func:`mean_difference` of one task's final returns or SM;
+* :func:`pooled_iqm` (and :func:`pooled_iqm_interval`): the IQM of every run when tasks hold unequal run counts;
 * :func:`difference_interval`: a 95 % stratified bootstrap interval of any of them (rliable's
   ``StratifiedIndependentBootstrap``: the runs of each agent are resampled within each task, independently);
 * :func:`seeds_to_resolve`: how many seeds per agent a two-sided test at level ``alpha`` would need to detect the
