@@ -173,16 +173,21 @@ def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarra
     return runs_by_algo, tasks
 
 
-def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
-    """:func:`normalized_final_runs` as rliable wants them: ``{algo: array (runs, tasks)}`` (runs cut to the
-    algorithm's smallest seed count, keeping the lowest seeds) and the tasks."""
-    runs_by_algo, tasks = normalized_final_runs(table)
+def equal_run_scores(runs_by_algo: dict[str, list[np.ndarray]]) -> dict[str, np.ndarray]:
+    """:func:`normalized_final_runs`' runs as rliable wants them: ``{algo: array (runs, tasks)}``, cut to the
+    algorithm's smallest run count over the tasks (its lowest seeds); an algorithm missing a task is left out."""
     scores: dict[str, np.ndarray] = {}
     for algo, per_task in runs_by_algo.items():
         n_runs = min(len(values) for values in per_task)
         if n_runs:
             scores[algo] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
-    return scores, tasks
+    return scores
+
+
+def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
+    """:func:`normalized_final_runs` cut by :func:`equal_run_scores`, and the tasks."""
+    runs_by_algo, tasks = normalized_final_runs(table)
+    return equal_run_scores(runs_by_algo), tasks
 
 
 def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:

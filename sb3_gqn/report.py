@@ -32,6 +32,7 @@ import pandas as pd
 
 from sb3_gqn.benchmark import warm_started
 from sb3_gqn.plots import (
+    equal_run_scores,
     final_rows,
     iqm_with_intervals,
     normalized_final_runs,
@@ -295,10 +296,10 @@ def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str
             "Returns around each growth (held: after >= 70 % of before, or within 50 below 100)", _markdown(pd.DataFrame(rows))
         )
 
-    scores, tasks = normalized_final_scores(table)
+    every_run, tasks = normalized_final_runs(table)
+    scores = equal_run_scores(every_run)
     if len(tasks) > 1 and scores:
         estimates, intervals = iqm_with_intervals(scores, reps)
-        every_run = normalized_final_runs(table)[0]
         # where some task has more runs than the cut keeps, also say what all of them give (same normalization)
         uneven = any(len({len(runs) for runs in every_run[algo]}) > 1 for algo in scores)
         rows = []

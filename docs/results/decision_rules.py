@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
 import pandas as pd
 
 from sb3_gqn.plots import final_rows
@@ -264,6 +265,20 @@ def probe_clauses(tables: dict[str, pd.DataFrame], rule: ProbeRule) -> tuple[lis
     return result, missing
 
 
+def difference_text(
+    values_x: np.ndarray, values_y: np.ndarray, spec: str, interval_spec: str, names: tuple[str, str] = ("", "")
+) -> str:
+    """``"<names[0]><mean x> vs <names[1]><mean y>, <x - y> [<low>, <high>]"``: the means and their difference with
+    its 95 % bootstrap interval (:func:`sb3_gqn.significance.difference_interval`)."""
+    from sb3_gqn.significance import difference_interval, mean_difference
+
+    difference, (low, high) = difference_interval(mean_difference, values_x, values_y)
+    return (
+        f"{names[0]}{values_x.mean():{spec}} vs {names[1]}{values_y.mean():{spec}}, "
+        f"{difference:{interval_spec}} [{low:{interval_spec}}, {high:{interval_spec}}]"
+    )
+
+
 @dataclass(frozen=True)
 class Confirmation:
     """A pre-stated extension of a table on fresh seeds (C1): R1's clauses read on those seeds, and the bar's SM item
@@ -306,8 +321,6 @@ def confirmation_clauses(
     table: pd.DataFrame, confirmation: Confirmation
 ) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
     """R1's clauses on the counted fresh seeds, the fresh seeds not yet counted, and the SM lines to report."""
-    from sb3_gqn.significance import difference_interval, mean_difference
-
     final = finished_runs(table, confirmation.env)
     counted = counted_seeds(final, confirmation)
     missing = {"both agents": absent} if (absent := [s for s in confirmation.fresh_seeds if s not in counted]) else {}
@@ -341,11 +354,8 @@ def confirmation_clauses(
         ]
         if min(len(v) for v in values) == 0:
             continue
-        difference, (low, high) = difference_interval(mean_difference, *values)
-        lines.append(
-            f"SM, {label} {seeds}: {confirmation.agents[0]} {values[0].mean():.5f} vs {confirmation.agents[1]} "
-            f"{values[1].mean():.5f}, {difference:+.5f} [{low:+.5f}, {high:+.5f}]"
-        )
+        names = (f"{confirmation.agents[0]} ", f"{confirmation.agents[1]} ")
+        lines.append(f"SM, {label} {seeds}: " + difference_text(*values, ".5f", "+.5f", names))
     return result, missing, lines
 
 
@@ -407,8 +417,6 @@ SEED_FILLS = [
 
 def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
     """C2's item (empty for a fill that only reports), the fresh seeds not yet counted, and the comparison lines."""
-    from sb3_gqn.significance import difference_interval, mean_difference
-
     agent = finished_runs(tables[fill.agent_table], fill.env)
     agent = agent[agent["algo"] == fill.agent]
     baseline = finished_runs(tables[fill.baseline_table], fill.env)
@@ -425,14 +433,10 @@ def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[li
         pair = [runs[runs["seed"].isin(seeds)] for runs in (agent, baseline)]
         if not seeds or min(len(runs) for runs in pair) == 0:
             continue
-        parts = []
-        for column, spec, interval in [("return", ".1f", "+.0f"), ("smoothness", ".5f", "+.5f")]:
-            values = [runs[column].to_numpy() for runs in pair]
-            difference, (low, high) = difference_interval(mean_difference, *values)
-            parts.append(
-                f"{'return' if column == 'return' else 'SM'} {values[0].mean():{spec}} vs {values[1].mean():{spec}}, "
-                f"{difference:{interval}} [{low:{interval}}, {high:{interval}}]"
-            )
+        parts = [
+            f"{name} " + difference_text(*(runs[column].to_numpy() for runs in pair), spec, interval)
+            for column, name, spec, interval in [("return", "return", ".1f", "+.0f"), ("smoothness", "SM", ".5f", "+.5f")]
+        ]
         lines.append(f"{label} {seeds}: " + "; ".join(parts))
     result = []
     if fill.item:
