@@ -316,3 +316,23 @@ def test_seed_fill_compares_matched_seeds_and_decides_the_walker_item_once_every
     assert (
         seed_fill_lines({"a": agent, "b": finished}, SeedFill("C", "E", "a", "gqn-adaptive+x", "b", "sac", [0], [1]))[0] == []
     )
+
+
+def test_seed_fill_of_a_variant_on_fresh_seeds_names_the_side_still_to_run_and_has_no_pooled_line():
+    from decision_rules import SeedFill, seed_fill_lines
+
+    # C4's finger form: the variant runs on seeds 0 and 1, the shipped entry has both; no earlier seeds
+    fill = SeedFill("C", "E", "a", "gqn-adaptive+twin", "a", "gqn-adaptive+x", [], [0, 1])
+    shipped = [("gqn-adaptive+x", seed, [0, 0, value], 9, "", sm) for seed, value, sm in [(0, 600, 0.018), (1, 400, 0.016)]]
+    variant = [("gqn-adaptive+twin", 0, [0, 0, 700], 9, "", 0.014)]
+    table = _rule_table_with_smoothness(shipped + variant)
+    result, missing, lines = seed_fill_lines({"a": table}, fill)
+    assert result == [] and missing == {"gqn-adaptive+twin": [1]}
+    assert len(lines) == 1 and lines[0].startswith("fresh seeds [0]: return 700.0 vs 600.0, +100")
+    assert "SM 0.01400 vs 0.01800, -0.00400" in lines[0]
+    # seed 1 finishes at 500: (700 + 500) / 2 = 600 vs 500; SM (0.014 + 0.012) / 2 = 0.013 vs 0.017
+    table = _rule_table_with_smoothness(shipped + variant + [("gqn-adaptive+twin", 1, [0, 0, 500], 9, "", 0.012)])
+    result, missing, lines = seed_fill_lines({"a": table}, fill)
+    assert missing == {} and len(lines) == 1
+    assert lines[0].startswith("fresh seeds [0, 1]: return 600.0 vs 500.0, +100 [")
+    assert "SM 0.01300 vs 0.01700, -0.00400 [" in lines[0]

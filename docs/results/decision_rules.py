@@ -361,9 +361,10 @@ def confirmation_clauses(
 
 @dataclass(frozen=True)
 class SeedFill:
-    """A pre-stated fill of a baseline's seeds (C2, C3): the agent's shipped entry against the baseline, final return
-    and SM, on the matched earlier seeds, the fresh ones the baseline has finished, and both. A fresh seed counts once
-    both have finished it.
+    """A pre-stated comparison on matched seeds (C2, C3, C4): the agent against the baseline, final return and SM, on
+    the earlier seeds, the fresh ones both have finished, and both groups together (when there are earlier seeds).
+    A fresh seed counts once both have finished it. C2 and C3 fill a baseline's seeds (the agent is the shipped
+    entry, the baseline SAC); C4 runs a variant (two critics) on fresh seeds against the shipped entry.
 
     :param item: C2's clause: the agent's mean final return over every counted seed at least the baseline's (the
         bar's walker item); ``False`` where the fill only reports (C3)
@@ -412,23 +413,57 @@ SEED_FILLS = [
         list(range(2)),
         [2, 3, 4, 5, 6, 7],
     ),
+    # two critics against each task's shipped entry on seeds 0 and 1: cartpole's and walker's ran before C4, finger's
+    # are C4's runs
+    SeedFill(
+        "C4",
+        "dm_control/cartpole-swingup-v0",
+        "cartpole-swingup_c0.1_100k",
+        "gqn-adaptive+twin",
+        "cartpole-swingup_c0.1_100k",
+        "gqn-adaptive",
+        [0, 1],
+        [],
+    ),
+    SeedFill(
+        "C4",
+        "dm_control/walker-walk-v0",
+        "walker-walk_c0.1_100k_torso",
+        "gqn-adaptive+twin",
+        "walker-walk_c0.1_100k_torso",
+        "gqn-adaptive+residual+1update",
+        [0, 1],
+        [],
+    ),
+    SeedFill(
+        "C4",
+        "dm_control/finger-spin-v0",
+        "finger-spin_c0.1_100k",
+        "gqn-adaptive+twin",
+        "finger-spin_c0.1_100k",
+        "gqn-adaptive+layernorm+1update",
+        [],
+        [0, 1],
+    ),
 ]
 
 
 def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
-    """C2's item (empty for a fill that only reports), the fresh seeds not yet counted, and the comparison lines."""
+    """C2's item (empty for a fill that only reports), each side's fresh seeds not yet finished, and the comparison
+    lines."""
     agent = finished_runs(tables[fill.agent_table], fill.env)
     agent = agent[agent["algo"] == fill.agent]
     baseline = finished_runs(tables[fill.baseline_table], fill.env)
     baseline = baseline[baseline["algo"] == fill.baseline]
-    done = set(agent["seed"].astype(int)) & set(baseline["seed"].astype(int))
-    counted = [seed for seed in fill.fresh_seeds if seed in done]
-    missing = {fill.baseline: absent} if (absent := [s for s in fill.fresh_seeds if s not in done]) else {}
+    finished = {name: set(runs["seed"].astype(int)) for name, runs in ((fill.agent, agent), (fill.baseline, baseline))}
+    counted = [seed for seed in fill.fresh_seeds if all(seed in seeds for seeds in finished.values())]
+    missing = {name: absent for name, seeds in finished.items() if (absent := [s for s in fill.fresh_seeds if s not in seeds])}
+    done = set.intersection(*finished.values())
     every = [seed for seed in fill.earlier_seeds if seed in done] + counted
     lines = []
-    groups = [("earlier seeds", fill.earlier_seeds)] + (
-        [("fresh seeds", counted), ("all counted seeds", every)] if counted else []
-    )
+    groups = [("earlier seeds", fill.earlier_seeds)] + ([("fresh seeds", counted)] if counted else [])
+    if counted and fill.earlier_seeds:
+        groups.append(("all counted seeds", every))
     for label, seeds in groups:
         pair = [runs[runs["seed"].isin(seeds)] for runs in (agent, baseline)]
         if not seeds or min(len(runs) for runs in pair) == 0:
