@@ -456,9 +456,9 @@ def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[li
     baseline = finished_runs(tables[fill.baseline_table], fill.env)
     baseline = baseline[baseline["algo"] == fill.baseline]
     finished = {name: set(runs["seed"].astype(int)) for name, runs in ((fill.agent, agent), (fill.baseline, baseline))}
-    counted = [seed for seed in fill.fresh_seeds if all(seed in seeds for seeds in finished.values())]
     missing = {name: absent for name, seeds in finished.items() if (absent := [s for s in fill.fresh_seeds if s not in seeds])}
     done = set.intersection(*finished.values())
+    counted = [seed for seed in fill.fresh_seeds if seed in done]
     every = [seed for seed in fill.earlier_seeds if seed in done] + counted
     lines = []
     groups = [("earlier seeds", fill.earlier_seeds)] + ([("fresh seeds", counted)] if counted else [])
