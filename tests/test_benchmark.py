@@ -278,6 +278,42 @@ def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_
     assert tables.entry_before(cartpole, "+residual") == ""
 
 
+def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
+    """Finger's shipped entry is compared with the residual torso on 4 seeds and with two critics on 2: the two-critic
+    comparison must read the entry's seeds 0 and 1 only (it once read all four, and a probe that is the shipped
+    entry was compared with itself on another probe's seeds)."""
+    import pandas as pd
+
+    from sb3_gqn.report import comparisons_per_task
+
+    tables = readme_tables()
+    finger = "dm_control/finger-spin-v0"
+    entry = tables.SHIPPED[finger]
+
+    def runs(algo: str, returns: list[float]) -> list[dict]:
+        return [
+            {"algo": algo, "env": finger, "penalty": 0.1, "seed": seed, "step": 100_000, "return": value, "smoothness": 0.01}
+            for seed, value in enumerate(returns)
+        ]
+
+    table = pd.DataFrame(
+        runs("gqn-adaptive" + entry, [100, 200, 900, 900])
+        + runs("gqn-adaptive+residual+1update", [300, 300, 300, 300])
+        + runs("gqn-adaptive+twin", [250, 250])
+    )
+    residual, twin = tables.item_5_kinds(table)
+    assert twin[1] == [("gqn-adaptive, two critics", "gqn-adaptive, shipped entry")]
+    twin_entry = pd.concat(twin[0]).query("algo == 'gqn-adaptive, shipped entry'")
+    assert sorted(twin_entry["seed"]) == [0, 1]
+    body = comparisons_per_task(pd.concat(twin[0]), twin[1], reps=200).body
+    # two critics 250 against the entry's (100 + 200) / 2 = 150 on seeds 0-1 (on all four it would read 525)
+    assert "| 2 / 2 | +100 [" in body
+    body = comparisons_per_task(pd.concat(residual[0]), residual[1], reps=200).body
+    assert "| 4 / 4 | -225 [" in body  # 300 against (100 + 200 + 900 + 900) / 4 = 525
+    merged = tables.merged_rows(["| env | x |\n| --- | --- |\n| b | 1 |\n| a | 2 |", "| env | x |\n| --- | --- |\n| a | 3 |"])
+    assert merged.splitlines() == ["| env | x |", "| --- | --- |", "| a | 2 |", "| a | 3 |", "| b | 1 |"]
+
+
 @pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])
 def test_help_texts_are_plain_text(module, capsys):
     entry_point = importlib.import_module(module).main

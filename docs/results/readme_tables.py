@@ -133,7 +133,11 @@ RESIDUAL_SUFFIXES = {
     "dm_control/walker-walk-v0": "+residual+1update",
 }
 #: two critics (``policy_kwargs=dict(n_critics=2)``) on the task's shipped torso and update ratio
-TWIN_SUFFIXES = {"dm_control/cartpole-swingup-v0": "+twin", "dm_control/walker-walk-v0": "+twin"}
+TWIN_SUFFIXES = {
+    "dm_control/cartpole-swingup-v0": "+twin",
+    "dm_control/finger-spin-v0": "+twin",
+    "dm_control/walker-walk-v0": "+twin",
+}
 
 
 def entry_before(env: str, suffix: str) -> str:
@@ -143,13 +147,15 @@ def entry_before(env: str, suffix: str) -> str:
     return entries[-2] if entries[-1] == suffix else entries[-1]
 
 
-def item_5_probes() -> str:
-    """The agents run with DecQN's residual torso or two critics against the entry they change, on the same seeds
-    (issue 11, item 5): the task's shipped entry, or the one shipped before it when the probe is the shipped entry
-    (``entry_before``)."""
-    table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])  # runner names: every entry apart
-    parts, pairs = [], []
+def item_5_kinds(table: pd.DataFrame) -> list[tuple[list[pd.DataFrame], list[tuple[str, str]]]]:
+    """Per probe kind (the residual torso, two critics), its runs and the runs of the entry each one changes on the
+    same seeds, relabelled (``"gqn-adaptive, two critics"``, ``"gqn-adaptive, shipped entry"``), and the pairs it
+    compares. ``table``: the main tables under the runner's names. The comparisons are computed per kind, so that an
+    entry that two kinds compare with (finger's, on 8 seeds for the torso and 2 for two critics) enters each
+    comparison on that probe's seeds only."""
+    kinds = []
     for suffixes, label in [(RESIDUAL_SUFFIXES, "residual torso"), (TWIN_SUFFIXES, "two critics")]:
+        parts, pairs = [], []
         for env, suffix in suffixes.items():
             before = entry_before(env, suffix)
             before_label = "shipped entry" if before == SHIPPED.get(env, "") else "earlier entry"
@@ -163,14 +169,25 @@ def item_5_probes() -> str:
                 parts.append(same_seeds.assign(algo=f"{agent}, {before_label}"))
                 if (f"{agent}, {label}", f"{agent}, {before_label}") not in pairs:
                     pairs.append((f"{agent}, {label}", f"{agent}, {before_label}"))
+        kinds.append((parts, pairs))
+    return kinds
+
+
+def item_5_probes() -> str:
+    """The agents run with DecQN's residual torso or two critics against the entry they change, on the same seeds
+    (issue 11, item 5): the task's shipped entry, or the one shipped before it when the probe is the shipped entry
+    (``entry_before``)."""
+    table = load([RESULTS / name / "results.csv" for name in MAIN_TABLES])  # runner names: every entry apart
+    kinds = item_5_kinds(table)
     # a task's entry runs appear once even when two probes compare with them
-    probes_and_entries = pd.concat(parts, ignore_index=True).drop_duplicates()
+    probes_and_entries = pd.concat([part for parts, _ in kinds for part in parts], ignore_index=True).drop_duplicates()
     sections = report_sections(probes_and_entries, reps=100)
     # the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run where SAC ran (walker)
-    pairs += [("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")]
-    with_sac = pd.concat([probes_and_entries, table[table["algo"] == "sac"]], ignore_index=True)
-    comparisons = comparisons_per_task(with_sac, pairs, reps=2000)
-    assert comparisons is not None, "every probe has the runs of the entry it changes on the same seeds"
+    kinds[0][1].extend([("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")])
+    sac = table[table["algo"] == "sac"]
+    per_kind = [comparisons_per_task(pd.concat([*parts, sac], ignore_index=True), pairs, reps=2000) for parts, pairs in kinds]
+    assert all(per_kind), "every probe has the runs of the entry it changes on the same seeds"
+    comparisons = merged_rows([section.body for section in per_kind if section is not None])
     return "\n\n".join(
         [
             sections["final"].body,
@@ -178,10 +195,18 @@ def item_5_probes() -> str:
             sections["means"].body,
             f"**{sections['growth'].heading}**",
             sections["growth"].body,
-            f"**{comparisons.heading}**; the entry it changes on the probe's seeds, SAC on all of its seeds",
-            comparisons.body,
+            f"**{per_kind[0].heading}**; the entry it changes on the probe's seeds, SAC on all of its seeds",
+            comparisons,
         ]
     )
+
+
+def merged_rows(tables: list[str]) -> str:
+    """Markdown tables with the same header as one table: the first one's header, then every table's rows, ordered
+    by their first cell (the task) and otherwise kept in order."""
+    header = tables[0].splitlines()[:2]
+    rows = [row for table in tables for row in table.splitlines()[2:]]
+    return "\n".join([*header, *sorted(rows, key=lambda row: row.split("|")[1])])
 
 
 def final_policies() -> str:
