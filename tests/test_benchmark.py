@@ -303,6 +303,11 @@ def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
     )
     residual, twin = tables.item_5_kinds(table)
     assert twin[1] == [("gqn-adaptive, two critics", "gqn-adaptive, shipped entry")]
+    assert residual[1] == [
+        ("gqn-adaptive, residual torso", "gqn-adaptive, shipped entry"),
+        ("gqn-adaptive, residual torso", "decqn-9, residual torso"),
+        ("gqn-adaptive, residual torso", "sac"),
+    ]
     twin_entry = pd.concat(twin[0]).query("algo == 'gqn-adaptive, shipped entry'")
     assert sorted(twin_entry["seed"]) == [0, 1]
     body = comparisons_per_task(pd.concat(twin[0]), twin[1], reps=200).body

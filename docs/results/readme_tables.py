@@ -153,8 +153,14 @@ def item_5_kinds(table: pd.DataFrame) -> list[tuple[list[pd.DataFrame], list[tup
     compares. ``table``: the main tables under the runner's names. The comparisons are computed per kind, so that an
     entry that two kinds compare with (finger's, on 8 seeds for the torso and 2 for two critics) enters each
     comparison on that probe's seeds only."""
+    # beside the entry it changes: the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run
+    # where SAC ran (item_5_probes adds the SAC runs)
+    residual_pairs = [("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")]
     kinds = []
-    for suffixes, label in [(RESIDUAL_SUFFIXES, "residual torso"), (TWIN_SUFFIXES, "two critics")]:
+    for suffixes, label, extra_pairs in [
+        (RESIDUAL_SUFFIXES, "residual torso", residual_pairs),
+        (TWIN_SUFFIXES, "two critics", []),
+    ]:
         parts, pairs = [], []
         for env, suffix in suffixes.items():
             before = entry_before(env, suffix)
@@ -169,7 +175,7 @@ def item_5_kinds(table: pd.DataFrame) -> list[tuple[list[pd.DataFrame], list[tup
                 parts.append(same_seeds.assign(algo=f"{agent}, {before_label}"))
                 if (f"{agent}, {label}", f"{agent}, {before_label}") not in pairs:
                     pairs.append((f"{agent}, {label}", f"{agent}, {before_label}"))
-        kinds.append((parts, pairs))
+        kinds.append((parts, pairs + extra_pairs))
     return kinds
 
 
@@ -182,8 +188,6 @@ def item_5_probes() -> str:
     # a task's entry runs appear once even when two probes compare with them
     probes_and_entries = pd.concat([part for parts, _ in kinds for part in parts], ignore_index=True).drop_duplicates()
     sections = report_sections(probes_and_entries, reps=100)
-    # the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run where SAC ran (walker)
-    kinds[0][1].extend([("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")])
     sac = table[table["algo"] == "sac"]
     per_kind = [comparisons_per_task(pd.concat([*parts, sac], ignore_index=True), pairs, reps=2000) for parts, pairs in kinds]
     assert all(per_kind), "every probe has the runs of the entry it changes on the same seeds"
