@@ -90,10 +90,11 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-2+residual+1update": ("decqn", {"bins": 2, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio (POLICY_KWARGS_ADDED)
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive"}),
+    "decqn-9+twin": ("decqn", {"bins": 9}),
 }
 #: Policy keyword arguments a variant adds to its entry's ``policy_kwargs`` (keeping the entry's torso), as the
 #: source of a ``dict(...)`` call like the entries' own
-POLICY_KWARGS_ADDED: dict[str, str] = {"gqn-adaptive+twin": "n_critics=2"}
+POLICY_KWARGS_ADDED: dict[str, str] = {"gqn-adaptive+twin": "n_critics=2", "decqn-9+twin": "n_critics=2"}
 
 
 def warm_started(algo: str) -> bool:

@@ -361,6 +361,13 @@ def test_two_critics_keep_the_entry_torso():
     assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["train_freq"] == 1
     # cartpole's entry has no policy_kwargs: its recorded twin runs trained exactly this
     assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0")["policy_kwargs"] == "dict(n_critics=2)"
+    # decqn-9's twin keeps decqn.yml's entry (finger's DecQN default torso) at 9 bins
+    finger_decqn = trained("decqn-9+twin", "dm_control/finger-spin-v0")
+    assert finger_decqn["policy_kwargs"] == "dict(layer_norm=True, activation_fn=nn.ELU, n_critics=2)"
+    assert finger_decqn["bins"] == 9 and finger_decqn["train_freq"] == 1
+    assert trained("decqn-9+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
+        "dict(residual_layer_norm=True, n_critics=2)"
+    )
     assert added_policy_kwargs("dict()", "n_critics=2") == "dict(n_critics=2)"
     with pytest.raises(ValueError, match="expected 'dict"):
         added_policy_kwargs("{'a': 1}", "n_critics=2")
