@@ -300,9 +300,16 @@ def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
         runs("gqn-adaptive" + entry, [100, 200, 900, 900])
         + runs("gqn-adaptive+residual+1update", [300, 300, 300, 300])
         + runs("gqn-adaptive+twin", [250, 250])
+        + runs("decqn-9" + entry, [400, 100, 500, 500])
+        + runs("decqn-9+twin", [300, 100])
     )
     residual, twin = tables.item_5_kinds(table)
-    assert twin[1] == [("gqn-adaptive, two critics", "gqn-adaptive, shipped entry")]
+    assert twin[1] == [
+        ("gqn-adaptive, two critics", "gqn-adaptive, shipped entry"),
+        ("decqn-9, two critics", "decqn-9, shipped entry"),
+        ("gqn-adaptive, two critics", "decqn-9, two critics"),
+        ("gqn-adaptive, shipped entry", "decqn-9, shipped entry"),
+    ]
     assert residual[1] == [
         ("gqn-adaptive, residual torso", "gqn-adaptive, shipped entry"),
         ("gqn-adaptive, residual torso", "decqn-9, residual torso"),
@@ -311,8 +318,14 @@ def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
     twin_entry = pd.concat(twin[0]).query("algo == 'gqn-adaptive, shipped entry'")
     assert sorted(twin_entry["seed"]) == [0, 1]
     body = comparisons_per_task(pd.concat(twin[0]), twin[1], reps=200).body
+    rows = {row.split(" | ")[1]: row for row in body.splitlines()[2:]}
     # two critics 250 against the entry's (100 + 200) / 2 = 150 on seeds 0-1 (on all four it would read 525)
-    assert "| 2 / 2 | +100 [" in body
+    assert "| 2 / 2 | +100 [" in rows["gqn-adaptive, two critics vs gqn-adaptive, shipped entry"]
+    # decqn-9's two critics (300 + 100) / 2 = 200 against its entry's (400 + 100) / 2 = 250 on the same seeds
+    assert "| 2 / 2 | -50 [" in rows["decqn-9, two critics vs decqn-9, shipped entry"]
+    assert "| 2 / 2 | +50 [" in rows["gqn-adaptive, two critics vs decqn-9, two critics"]  # 250 against 200
+    # the shipped pair on the two-critic seeds only: 150 against 250 (on all four seeds 525 against 375)
+    assert "| 2 / 2 | -100 [" in rows["gqn-adaptive, shipped entry vs decqn-9, shipped entry"]
     body = comparisons_per_task(pd.concat(residual[0]), residual[1], reps=200).body
     assert "| 4 / 4 | -225 [" in body  # 300 against (100 + 200 + 900 + 900) / 4 = 525
     merged = tables.merged_rows(["| env | x |\n| --- | --- |\n| b | 1 |\n| a | 2 |", "| env | x |\n| --- | --- |\n| a | 3 |"])

@@ -7,7 +7,8 @@ reads a probe's own table (``docs/results/probes/...``, whose algorithm names ar
 probe patched) against bars taken from the main tables. C1 (:class:`Confirmation`) reads R1's clauses on fresh seeds
 of the entry R1 switched to, and reports the bar's SM item on the earlier seeds, the fresh ones and both. C2 and C3
 (:class:`SeedFill`) compare gqn-adaptive's shipped entry with SAC on matched seeds as SAC's fresh seeds finish; C2
-decides the bar's walker item on them.
+decides the bar's walker item on them. C4 and C5 (also :class:`SeedFill`) compare two critics with each task's
+shipped entries, and gqn-adaptive with decqn-9 when both run two critics.
 
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
@@ -361,10 +362,11 @@ def confirmation_clauses(
 
 @dataclass(frozen=True)
 class SeedFill:
-    """A pre-stated comparison on matched seeds (C2, C3, C4): the agent against the baseline, final return and SM, on
+    """A pre-stated comparison on matched seeds (C2-C5): the agent against the baseline, final return and SM, on
     the earlier seeds, the fresh ones both have finished, and both groups together (when there are earlier seeds).
     A fresh seed counts once both have finished it. C2 and C3 fill a baseline's seeds (the agent is the shipped
-    entry, the baseline SAC); C4 runs a variant (two critics) on fresh seeds against the shipped entry.
+    entry, the baseline SAC); C4 runs a variant (two critics) on fresh seeds against the shipped entry; C5 runs
+    decqn-9's, against its shipped entry and against gqn-adaptive's.
 
     :param item: C2's clause: the agent's mean final return over every counted seed at least the baseline's (the
         bar's walker item); ``False`` where the fill only reports (C3)
@@ -445,6 +447,27 @@ SEED_FILLS = [
         [],
         [0, 1],
     ),
+]
+#: C5's tasks: the table with both agents' runs, and gqn-adaptive's and decqn-9's shipped entries (runner names)
+C5_TASKS: dict[str, tuple[str, str, str]] = {
+    "dm_control/walker-walk-v0": (
+        "walker-walk_c0.1_100k_torso",
+        "gqn-adaptive+residual+1update",
+        "decqn-9+residual+1update",
+    ),
+    "dm_control/finger-spin-v0": ("finger-spin_c0.1_100k", "gqn-adaptive+layernorm+1update", "decqn-9+layernorm+1update"),
+    "dm_control/cartpole-swingup-v0": ("cartpole-swingup_c0.1_100k", "gqn-adaptive", "decqn-9"),
+}
+# C5, per task on seeds 0 and 1: (a) decqn-9 with two critics against its shipped entry; (b) gqn-adaptive with two
+# critics against decqn-9 with two critics, then the shipped pair on the same seeds (both ran before C5)
+SEED_FILLS += [
+    SeedFill("C5", env, table, agent, table, baseline, earlier, fresh)
+    for env, (table, gqn_shipped, decqn_shipped) in C5_TASKS.items()
+    for agent, baseline, earlier, fresh in [
+        ("decqn-9+twin", decqn_shipped, [], [0, 1]),
+        ("gqn-adaptive+twin", "decqn-9+twin", [], [0, 1]),
+        (gqn_shipped, decqn_shipped, [0, 1], []),
+    ]
 ]
 
 

@@ -156,10 +156,15 @@ def item_5_kinds(table: pd.DataFrame) -> list[tuple[list[pd.DataFrame], list[tup
     # beside the entry it changes: the torso's GQN against its DecQN-9 on the same seeds, and against every SAC run
     # where SAC ran (item_5_probes adds the SAC runs)
     residual_pairs = [("gqn-adaptive, residual torso", "decqn-9, residual torso"), ("gqn-adaptive, residual torso", "sac")]
+    # the bar's pair with both agents on two critics (C5), and with both on their shipped entries on the same seeds
+    twin_pairs = [
+        ("gqn-adaptive, two critics", "decqn-9, two critics"),
+        ("gqn-adaptive, shipped entry", "decqn-9, shipped entry"),
+    ]
     kinds = []
     for suffixes, label, extra_pairs in [
         (RESIDUAL_SUFFIXES, "residual torso", residual_pairs),
-        (TWIN_SUFFIXES, "two critics", []),
+        (TWIN_SUFFIXES, "two critics", twin_pairs),
     ]:
         parts, pairs = [], []
         for env, suffix in suffixes.items():
