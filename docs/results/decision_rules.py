@@ -415,41 +415,10 @@ SEED_FILLS = [
         list(range(2)),
         [2, 3, 4, 5, 6, 7],
     ),
-    # two critics against each task's shipped entry on seeds 0 and 1: cartpole's and walker's ran before C4, finger's
-    # are C4's runs
-    SeedFill(
-        "C4",
-        "dm_control/cartpole-swingup-v0",
-        "cartpole-swingup_c0.1_100k",
-        "gqn-adaptive+twin",
-        "cartpole-swingup_c0.1_100k",
-        "gqn-adaptive",
-        [0, 1],
-        [],
-    ),
-    SeedFill(
-        "C4",
-        "dm_control/walker-walk-v0",
-        "walker-walk_c0.1_100k_torso",
-        "gqn-adaptive+twin",
-        "walker-walk_c0.1_100k_torso",
-        "gqn-adaptive+residual+1update",
-        [0, 1],
-        [],
-    ),
-    SeedFill(
-        "C4",
-        "dm_control/finger-spin-v0",
-        "finger-spin_c0.1_100k",
-        "gqn-adaptive+twin",
-        "finger-spin_c0.1_100k",
-        "gqn-adaptive+layernorm+1update",
-        [],
-        [0, 1],
-    ),
 ]
-#: C5's tasks: the table with both agents' runs, and gqn-adaptive's and decqn-9's shipped entries (runner names)
-C5_TASKS: dict[str, tuple[str, str, str]] = {
+#: the two-critic checks' tasks (C4, C5): the table with the runs, and gqn-adaptive's and decqn-9's shipped entries
+#: (runner names)
+TWIN_TASKS: dict[str, tuple[str, str, str]] = {
     "dm_control/walker-walk-v0": (
         "walker-walk_c0.1_100k_torso",
         "gqn-adaptive+residual+1update",
@@ -458,11 +427,21 @@ C5_TASKS: dict[str, tuple[str, str, str]] = {
     "dm_control/finger-spin-v0": ("finger-spin_c0.1_100k", "gqn-adaptive+layernorm+1update", "decqn-9+layernorm+1update"),
     "dm_control/cartpole-swingup-v0": ("cartpole-swingup_c0.1_100k", "gqn-adaptive", "decqn-9"),
 }
+# C4, two critics against each task's shipped entry on seeds 0 and 1: cartpole's and walker's ran before C4
+# (earlier seeds), finger's are C4's runs (fresh seeds)
+SEED_FILLS += [
+    SeedFill("C4", env, TWIN_TASKS[env][0], "gqn-adaptive+twin", TWIN_TASKS[env][0], TWIN_TASKS[env][1], earlier, fresh)
+    for env, earlier, fresh in [
+        ("dm_control/cartpole-swingup-v0", [0, 1], []),
+        ("dm_control/walker-walk-v0", [0, 1], []),
+        ("dm_control/finger-spin-v0", [], [0, 1]),
+    ]
+]
 # C5, per task on seeds 0 and 1: (a) decqn-9 with two critics against its shipped entry; (b) gqn-adaptive with two
 # critics against decqn-9 with two critics, then the shipped pair on the same seeds (both ran before C5)
 SEED_FILLS += [
     SeedFill("C5", env, table, agent, table, baseline, earlier, fresh)
-    for env, (table, gqn_shipped, decqn_shipped) in C5_TASKS.items()
+    for env, (table, gqn_shipped, decqn_shipped) in TWIN_TASKS.items()
     for agent, baseline, earlier, fresh in [
         ("decqn-9+twin", decqn_shipped, [], [0, 1]),
         ("gqn-adaptive+twin", "decqn-9+twin", [], [0, 1]),
