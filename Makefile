@@ -33,7 +33,7 @@ benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
 
-# The README's generated results blocks and docs/results/main's figures, from the committed docs/results tables
+# The results report's generated blocks (docs/results/README.md) and docs/results/main's figures, from the committed docs/results tables
 readme-tables: venv
 	$(BIN)/python docs/results/readme_tables.py
 

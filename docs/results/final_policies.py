@@ -8,9 +8,9 @@ each of the 9 bin values of [-1, 1] (normalized actions; SAC's continuous action
 bin), the share at the extremes (the bins -1 and +1), the share of steps on which an entry changes, and the
 share of consecutive changes that reverse direction (chatter): ``sb3_gqn.metrics.bin_usage``. Rows go to
 ``docs/results/final_policies.csv`` (replacing earlier rows of the same run); ``make readme-tables`` turns
-the CSV into the README's table.
+the CSV into the results report's table (docs/results/README.md).
 
-    .venv/bin/python docs/results/final_policies.py                    # the runs of the README's comparison
+    .venv/bin/python docs/results/final_policies.py                    # the runs of the results report's comparison
     .venv/bin/python docs/results/final_policies.py --algos gqn-adaptive decqn-9 --tables finger-spin_c0.1_100k
     .venv/bin/python docs/results/final_policies.py --algos decqn-9+residual+1update --only-new   # added runs only
 """

@@ -1,6 +1,7 @@
-"""Rebuild the README's generated results blocks from the committed tables (``make readme-tables``).
+"""Rebuild the results report's generated blocks from the committed tables (``make readme-tables``).
 
-Each block sits between ``<!-- BEGIN generated: NAME -->`` and ``<!-- END generated: NAME -->`` in README.md and
+Each block sits between ``<!-- BEGIN generated: NAME -->`` and ``<!-- END generated: NAME -->`` in
+``docs/results/README.md`` (issue 11's results report; the top-level README keeps the bar at a glance) and
 is the output of ``sb3_gqn.report`` on the committed ``docs/results/*/results.csv`` files; the prose around
 the blocks (what the figures mean, what misses) is written by hand. Figures go to ``docs/results/main``.
 Run from the repository root after extending a table with the comparison runner.
@@ -18,7 +19,8 @@ from sb3_gqn.plots import aggregate, learning_curves, smoothness_radar
 from sb3_gqn.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
 
 RESULTS = Path("docs/results")
-README = Path("README.md")
+#: the report the blocks live in; its links are relative to ``docs/results``
+README = RESULTS / "README.md"
 #: The entries (gqn.yml, decqn.yml) a task has shipped, oldest first, each as the runner's variant suffix that trains
 #: exactly it ("" = the plain names: the entry before issue 11); the last is the shipped one. Tasks not listed have
 #: shipped one entry, the plain names'.
@@ -104,7 +106,7 @@ def main_comparison() -> str:
             f"**{per_task.heading}**",
             per_task.body,
             "\n".join(
-                f"![{path.stem.replace('_', ' ')}](docs/results/main/{path.name})"
+                f"![{path.stem.replace('_', ' ')}](main/{path.name})"
                 for path in sorted((RESULTS / "main").glob("learning_curves_*.png"))
             ),
         ]

@@ -3,7 +3,7 @@ return accounts for (issue 11, claim iii).
 
 Across runs, a policy that drives the task harder moves more (walker-walk: GQN's final runs at task return 581-908,
 decqn-9's at lower returns), so a raw SM difference mixes smoothness with performance. Per task, on the final
-greedy evaluation (at 100k steps) of each finished run of the shipped entries (the README's main tables,
+greedy evaluation (at 100k steps) of each finished run of the shipped entries (the results report's main tables,
 ``readme_tables.shipped``), this fits one least-squares line through both agents' runs with a common slope and an
 agent offset,
 
