@@ -8,7 +8,8 @@ probe patched) against bars taken from the main tables. C1 (:class:`Confirmation
 of the entry R1 switched to, and reports the bar's SM item on the earlier seeds, the fresh ones and both. C2 and C3
 (:class:`SeedFill`) compare gqn-adaptive's shipped entry with SAC on matched seeds as SAC's fresh seeds finish; C2
 decides the bar's walker item on them. C4 and C5 (also :class:`SeedFill`) compare two critics with each task's
-shipped entries, and gqn-adaptive with decqn-9 when both run two critics.
+shipped entries, and gqn-adaptive with decqn-9 when both run two critics. C6 (a :class:`SeedFill` with ``growth``)
+extends finger's and cartpole's shipped pair to seeds 8-11 and also counts the fresh GQN runs' growth events.
 
 A rule reads one task's table and compares a candidate entry (the runner's variant suffix that trains it, e.g.
 ``+residual+1update``) with the shipped one on the tables' seeds (``RULE_SEEDS``). Only finished runs count (a run
@@ -370,6 +371,8 @@ class SeedFill:
 
     :param item: C2's clause: the agent's mean final return over every counted seed at least the baseline's (the
         bar's walker item); ``False`` where the fill only reports (C3)
+    :param growth: also report the agent's growth events on the counted fresh seeds, the ones that miss the collapse
+        criterion and the runs short of 9 bins (C6: the bar's collapse and 9-bin items count those runs)
     """
 
     name: str
@@ -381,6 +384,7 @@ class SeedFill:
     earlier_seeds: list[int]
     fresh_seeds: list[int]
     item: bool = False
+    growth: bool = False
 
 
 SEED_FILLS = [
@@ -448,6 +452,36 @@ SEED_FILLS += [
         (gqn_shipped, decqn_shipped, [0, 1], []),
     ]
 ]
+# C6, finger's and cartpole's shipped pair on fresh seeds 8-11 (seeds 0-7 ran before it), with the growth counts
+SEED_FILLS += [
+    SeedFill("C6", env, table, gqn_shipped, table, decqn_shipped, list(range(8)), [8, 9, 10, 11], growth=True)
+    for env, (table, gqn_shipped, decqn_shipped) in TWIN_TASKS.items()
+    if env != "dm_control/walker-walk-v0"
+]
+
+
+def fresh_growth_lines(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> list[str]:
+    """``algo``'s growth events on ``env`` for ``seeds`` (finished runs): how many hold the collapse criterion, each
+    miss, and the runs at 9 bins with the step each reached them (C6)."""
+    if not seeds:
+        return []
+    checks = [check for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds]
+    misses = [
+        f"seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
+        for check in checks
+        if check.held is False
+    ]
+    finals = finished_runs(table, env)
+    finals = finals[(finals["algo"] == algo) & finals["seed"].isin(seeds)]
+    nine = {check.seed: check.step for check in checks if check.bins == 9}
+    reached = ", ".join(f"seed {seed} at {nine[seed] // 1000}k" for seed in sorted(nine))
+    short = sorted(set(finals["seed"].astype(int)) - set(nine))
+    return [
+        f"growth events on the fresh seeds {seeds}: {len(checks) - len(misses)} of {len(checks)} hold"
+        + (f" (misses: {'; '.join(misses)})" if misses else ""),
+        f"runs at 9 bins: {len(finals) - len(short)} of {len(finals)} ({reached})"
+        + (f"; short: seeds {short}" if short else ""),
+    ]
 
 
 def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[list[Clause], dict[str, list[int]], list[str]]:
@@ -475,6 +509,8 @@ def seed_fill_lines(tables: dict[str, pd.DataFrame], fill: SeedFill) -> tuple[li
             for column, name, spec, interval in [("return", "return", ".1f", "+.0f"), ("smoothness", "SM", ".5f", "+.5f")]
         ]
         lines.append(f"{label} {seeds}: " + "; ".join(parts))
+    if fill.growth:
+        lines += fresh_growth_lines(tables[fill.agent_table], fill.env, fill.agent, counted)
     result = []
     if fill.item:
         pair = [runs[runs["seed"].isin(every)]["return"] for runs in (agent, baseline)]
