@@ -360,3 +360,15 @@ def test_seed_fill_with_growth_counts_the_fresh_runs_growth_events_and_bins():
     # without growth=True the same fill reports no growth lines
     plain = SeedFill("C", "E", "a", "gqn-adaptive+x", "a", "decqn-9+x", [0], [2, 3])
     assert not any("growth" in line for line in seed_fill_lines({"a": _rule_table_with_smoothness(runs)}, plain)[2])
+
+
+def test_difference_text_has_an_interval_only_with_two_runs_a_side():
+    from decision_rules import difference_text
+
+    # one run a side: 502 - 33 = +469 and no bootstrap interval (it would be NaN)
+    assert difference_text(np.array([502.0]), np.array([33.0]), ".1f", "+.0f") == (
+        "502.0 vs 33.0, +469 (one run on a side: no interval)"
+    )
+    # two a side: the means (1 + 3) / 2 = 2 and 0, the difference +2 with an interval inside [1, 3]
+    text = difference_text(np.array([1.0, 3.0]), np.array([0.0, 0.0]), ".1f", "+.1f")
+    assert text.startswith("2.0 vs 0.0, +2.0 [") and "nan" not in text

@@ -271,14 +271,16 @@ def difference_text(
     values_x: np.ndarray, values_y: np.ndarray, spec: str, interval_spec: str, names: tuple[str, str] = ("", "")
 ) -> str:
     """``"<names[0]><mean x> vs <names[1]><mean y>, <x - y> [<low>, <high>]"``: the means and their difference with
-    its 95 % bootstrap interval (:func:`sb3_gqn.significance.difference_interval`)."""
+    its 95 % bootstrap interval (:func:`sb3_gqn.significance.difference_interval`); with one run on a side there is
+    no interval to draw, and the text says so (``"<x - y> (one run per side: no interval)"``)."""
     from sb3_gqn.significance import difference_interval, mean_difference
 
+    means = f"{names[0]}{values_x.mean():{spec}} vs {names[1]}{values_y.mean():{spec}}, "
+    if min(len(values_x), len(values_y)) < 2:
+        difference = values_x.mean() - values_y.mean()
+        return means + f"{difference:{interval_spec}} (one run on a side: no interval)"
     difference, (low, high) = difference_interval(mean_difference, values_x, values_y)
-    return (
-        f"{names[0]}{values_x.mean():{spec}} vs {names[1]}{values_y.mean():{spec}}, "
-        f"{difference:{interval_spec}} [{low:{interval_spec}}, {high:{interval_spec}}]"
-    )
+    return means + f"{difference:{interval_spec}} [{low:{interval_spec}}, {high:{interval_spec}}]"
 
 
 @dataclass(frozen=True)
