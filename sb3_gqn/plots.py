@@ -173,21 +173,26 @@ def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarra
     return runs_by_algo, tasks
 
 
-def equal_run_scores(runs_by_algo: dict[str, list[np.ndarray]]) -> dict[str, np.ndarray]:
+def equal_run_scores(runs_by_algo: dict[str, list[np.ndarray]], max_runs: int | None = None) -> dict[str, np.ndarray]:
     """:func:`normalized_final_runs`' runs as rliable wants them: ``{algo: array (runs, tasks)}``, cut to the
-    algorithm's smallest run count over the tasks (its lowest seeds); an algorithm missing a task is left out."""
+    algorithm's smallest run count over the tasks (its lowest seeds), and to ``max_runs`` when given (a comparison
+    fixed at a seed count before later seeds ran); an algorithm missing a task is left out."""
     scores: dict[str, np.ndarray] = {}
     for algo, per_task in runs_by_algo.items():
         n_runs = min(len(values) for values in per_task)
+        if max_runs is not None:
+            n_runs = min(n_runs, max_runs)
         if n_runs:
             scores[algo] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
     return scores
 
 
-def normalized_final_scores(table: pd.DataFrame) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
-    """:func:`normalized_final_runs` cut by :func:`equal_run_scores`, and the tasks."""
+def normalized_final_scores(
+    table: pd.DataFrame, max_runs: int | None = None
+) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
+    """:func:`normalized_final_runs` cut by :func:`equal_run_scores` (``max_runs``: see there), and the tasks."""
     runs_by_algo, tasks = normalized_final_runs(table)
-    return equal_run_scores(runs_by_algo), tasks
+    return equal_run_scores(runs_by_algo, max_runs), tasks
 
 
 def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:
@@ -208,9 +213,10 @@ def iqm_with_intervals(
         return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
 
 
-def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000) -> Path:
-    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs."""
-    scores, tasks = normalized_final_scores(table)
+def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None) -> Path:
+    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs, on at
+    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`)."""
+    scores, tasks = normalized_final_scores(table, max_runs)
     estimates, intervals = iqm_with_intervals(scores, reps)
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
     figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))

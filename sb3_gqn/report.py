@@ -175,11 +175,13 @@ def _with_interval(value: float, interval: tuple[float, float], spec: str) -> st
     return f"{value:{spec}} [{interval[0]:{spec}}, {interval[1]:{spec}}]"
 
 
-def comparisons_across_tasks(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> Section | None:
+def comparisons_across_tasks(
+    table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000, max_runs: int | None = None
+) -> Section | None:
     """IQM(A) - IQM(B) and P(A > B) on the min-max normalized final returns of the IQM table, with 95 % bootstrap
     intervals, for each pair ``(A, B)`` of ``pairs`` with runs of both on every task (None if no pair has, or the
-    table has one task)."""
-    scores, tasks = normalized_final_scores(table)
+    table has one task); ``max_runs`` caps the runs per task as the IQM table's (:func:`report_sections`)."""
+    scores, tasks = normalized_final_scores(table, max_runs)
     rows = []
     for first, second in pairs:
         if first in scores and second in scores and len(tasks) > 1:
@@ -237,20 +239,25 @@ def comparisons_per_task(table: pd.DataFrame, pairs: list[tuple[str, str]], reps
     )
 
 
-def comparison_sections(table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000) -> dict[str, Section]:
+def comparison_sections(
+    table: pd.DataFrame, pairs: list[tuple[str, str]], reps: int = 2000, max_runs: int | None = None
+) -> dict[str, Section]:
     """How far the seeds resolve each comparison of ``pairs`` (``(A, B)``: A compared with B), by key:
-    ``comparison_tasks`` (:func:`comparisons_across_tasks`) and ``comparison_per_task`` (:func:`comparisons_per_task`)
-    where the table has them."""
+    ``comparison_tasks`` (:func:`comparisons_across_tasks`, ``max_runs`` as there) and ``comparison_per_task``
+    (:func:`comparisons_per_task`) where the table has them."""
     sections = {
-        "comparison_tasks": comparisons_across_tasks(table, pairs, reps),
+        "comparison_tasks": comparisons_across_tasks(table, pairs, reps, max_runs),
         "comparison_per_task": comparisons_per_task(table, pairs, reps),
     }
     return {key: section for key, section in sections.items() if section is not None}
 
 
-def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None) -> dict[str, Section]:
+def report_sections(
+    table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None, max_runs: int | None = None
+) -> dict[str, Section]:
     """The report's tables by key: ``final``, ``means``, then ``growth`` (GQN runs only), ``iqm`` (two tasks
-    or more) and, for ``pairs``, ``comparison_tasks`` and ``comparison_per_task`` where the table has them."""
+    or more) and, for ``pairs``, ``comparison_tasks`` and ``comparison_per_task`` where the table has them.
+    ``max_runs`` caps the IQM's runs per task and agent (its lowest seeds); the "every run" columns pool them all."""
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
     sections: dict[str, Section] = {}
     columns = {
@@ -297,11 +304,11 @@ def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str
         )
 
     every_run, tasks = normalized_final_runs(table)
-    scores = equal_run_scores(every_run)
+    scores = equal_run_scores(every_run, max_runs)
     if len(tasks) > 1 and scores:
         estimates, intervals = iqm_with_intervals(scores, reps)
         # where some task has more runs than the cut keeps, also say what all of them give (same normalization)
-        uneven = any(len({len(runs) for runs in every_run[algo]}) > 1 for algo in scores)
+        uneven = any(len(runs) != scores[algo].shape[0] for algo in scores for runs in every_run[algo])
         rows = []
         for algo in sorted(scores, key=lambda algo: -float(estimates[algo][0])):
             row = {
@@ -319,12 +326,13 @@ def report_sections(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str
         heading = f"IQM of min-max normalized final return across {len(tasks)} tasks ({names})"
         if uneven:
             heading += (
-                "; IQM: each agent's lowest seeds, as many on every task; every run: all of them pooled "
-                "(the bootstrap resamples within each task)"
+                "; IQM: each agent's lowest seeds, as many on every task"
+                + (f" and at most {max_runs}" if max_runs is not None else "")
+                + "; every run: all of them pooled (the bootstrap resamples within each task)"
             )
         sections["iqm"] = Section(heading, _markdown(pd.DataFrame(rows)))
     if pairs:
-        sections.update(comparison_sections(table, pairs, reps))
+        sections.update(comparison_sections(table, pairs, reps, max_runs))
     return sections
 
 

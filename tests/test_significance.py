@@ -157,6 +157,23 @@ def test_iqm_table_keeps_the_lowest_seeds_and_pools_every_run_where_counts_diffe
     assert "every run: all of them pooled" in iqm.heading
 
 
+def test_iqm_table_capped_at_max_runs_keeps_each_agents_lowest_seeds_and_pools_every_run():
+    # Normalized per task over all runs: task one over 0..30, a = 1/3, 2/3, 1; task two over 100..300, a = 1, 0, 1/2.
+    # max_runs=2 keeps a's seeds 0 and 1: 1/3, 2/3, 1, 0 -> sorted 0, 1/3, 2/3, 1, 1 off each end -> 0.50. Every run
+    # (3 / 3): 0, 1/3, 1/2, 2/3, 1, 1, 1 off each end -> (1/3 + 1/2 + 2/3 + 1) / 4 = 0.625, printed 0.62
+    sections = report_sections(_two_task_table(), reps=50, pairs=[("a", "b")], max_runs=2)
+    row_a = next(line for line in sections["iqm"].body.splitlines() if line.startswith("| a |"))
+    assert "| 2 | 0.50 |" in row_a and "| 3 / 3 | 0.62 [" in row_a
+    assert "at most 2" in sections["iqm"].heading
+    # the across-task comparison reads the same capped runs
+    assert "| a vs b | 2 / 2 |" in sections["comparison_tasks"].body
+    # a cap above every count changes nothing
+    assert (
+        report_sections(_two_task_table(), reps=50, max_runs=5)["iqm"].body
+        == report_sections(_two_task_table(), reps=50)["iqm"].body
+    )
+
+
 def test_compare_option_rejects_bad_pairs_and_unknown_algorithms(tmp_path, capsys):
     table = tmp_path / "results.csv"
     _two_task_table().to_csv(table, index=False)
