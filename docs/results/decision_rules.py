@@ -272,7 +272,7 @@ def difference_text(
 ) -> str:
     """``"<names[0]><mean x> vs <names[1]><mean y>, <x - y> [<low>, <high>]"``: the means and their difference with
     its 95 % bootstrap interval (:func:`sb3_gqn.significance.difference_interval`); with one run on a side there is
-    no interval to draw, and the text says so (``"<x - y> (one run per side: no interval)"``)."""
+    no interval to draw, and the text says so (``"<x - y> (one run on a side: no interval)"``)."""
     from sb3_gqn.significance import difference_interval, mean_difference
 
     means = f"{names[0]}{values_x.mean():{spec}} vs {names[1]}{values_y.mean():{spec}}, "
