@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from sb3_gqn.plots import final_rows
-from sb3_gqn.report import growth_checks
+from sb3_gqn.report import GrowthCheck, growth_checks
 
 RESULTS = Path(__file__).resolve().parent
 STEPS = 100_000
@@ -93,23 +93,29 @@ def missing_seeds(final: pd.DataFrame, suffix: str) -> dict[str, list[int]]:
     return missing
 
 
+def run_growth_checks(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> list[GrowthCheck]:
+    """The growth events of ``algo``'s runs on ``env`` with ``seeds``, each with its collapse verdict."""
+    return [check for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds]
+
+
+def miss_text(check: GrowthCheck) -> str:
+    """One growth event that misses the collapse criterion: seed, level, step, the returns around it."""
+    return f"seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
+
+
 def growth_misses(table: pd.DataFrame, env: str, suffix: str, seeds_of: dict[str, list[int]]) -> list[str]:
     """The growth events of the entry ``suffix``'s GQN runs on ``seeds_of`` that miss the collapse criterion."""
-    misses = []
-    for check in growth_checks(table[table["env"] == env]):
-        agent = check.algo.removesuffix(suffix) if suffix else check.algo
-        if check.algo != agent + suffix or agent not in GROWING_AGENTS or check.seed not in seeds_of.get(agent, []):
-            continue
-        if check.held is False:
-            misses.append(
-                f"{agent} seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
-            )
-    return misses
+    return [
+        f"{agent} {miss_text(check)}"
+        for agent in GROWING_AGENTS
+        for check in run_growth_checks(table, env, agent + suffix, seeds_of.get(agent, []))
+        if check.held is False
+    ]
 
 
 def growth_events(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> int:
     """How many growth events the runs of ``algo`` on ``env`` with ``seeds`` have (what the miss counts are out of)."""
-    return sum(1 for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds)
+    return len(run_growth_checks(table, env, algo, seeds))
 
 
 def clauses(table: pd.DataFrame, rule: Rule) -> tuple[list[Clause], dict[str, list[int]]]:
@@ -467,12 +473,8 @@ def fresh_growth_lines(table: pd.DataFrame, env: str, algo: str, seeds: list[int
     miss, and the runs at 9 bins with the step each reached them (C6)."""
     if not seeds:
         return []
-    checks = [check for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds]
-    misses = [
-        f"seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
-        for check in checks
-        if check.held is False
-    ]
+    checks = run_growth_checks(table, env, algo, seeds)
+    misses = [miss_text(check) for check in checks if check.held is False]
     finals = finished_runs(table, env)
     finals = finals[(finals["algo"] == algo) & finals["seed"].isin(seeds)]
     nine = {check.seed: check.step for check in checks if check.bins == 9}
