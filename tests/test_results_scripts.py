@@ -372,3 +372,16 @@ def test_difference_text_has_an_interval_only_with_two_runs_a_side():
     # two a side: the means (1 + 3) / 2 = 2 and 0, the difference +2 with an interval inside [1, 3]
     text = difference_text(np.array([1.0, 3.0]), np.array([0.0, 0.0]), ".1f", "+.1f")
     assert text.startswith("2.0 vs 0.0, +2.0 [") and "nan" not in text
+
+
+def test_c4_to_c6_name_the_entries_shipped_today():
+    """C4-C6 name their entries as written; today those are the entries the report ships (a later switch would
+    make this fail and call for a look at the checks, not a silent change of what they read)."""
+    from decision_rules import TWIN_TASKS
+    from readme_tables import MAIN_TABLES, SHIPPED
+
+    assert set(TWIN_TASKS) == {"dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"}
+    for env, (table, gqn_entry, decqn_entry) in TWIN_TASKS.items():
+        suffix = SHIPPED.get(env, "")
+        assert (gqn_entry, decqn_entry) == ("gqn-adaptive" + suffix, "decqn-9" + suffix)
+        assert table in MAIN_TABLES and table.startswith(env.removeprefix("dm_control/").removesuffix("-v0"))

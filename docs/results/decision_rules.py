@@ -428,8 +428,9 @@ SEED_FILLS = [
         [2, 3, 4, 5, 6, 7],
     ),
 ]
-#: the two-critic checks' tasks (C4, C5): the table with the runs, and gqn-adaptive's and decqn-9's shipped entries
-#: (runner names)
+#: the tasks of C4, C5 and C6: the table with the runs, and gqn-adaptive's and decqn-9's shipped entries (runner
+#: names). Written out, not read from ``readme_tables.SHIPPED``: each check reads the entries it named when it was
+#: written, even if a later rule ships another (``test_c4_to_c6_name_the_entries_shipped_today`` checks they agree now)
 TWIN_TASKS: dict[str, tuple[str, str, str]] = {
     "dm_control/walker-walk-v0": (
         "walker-walk_c0.1_100k_torso",
