@@ -88,8 +88,22 @@ def save_q_snapshot(run_dir: Path) -> QValueSnapshots:
     return QValueSnapshots(run_dir)
 
 
+def mean_curve(runs: pd.DataFrame) -> pd.DataFrame:
+    """One agent's learning curve, per evaluation step: the return's mean, std and run count over seeds, and the
+    *median* training wall time at that step.
+
+    The median, not the mean: a table gathers runs from several sessions, and a minority trained on a loaded or
+    slower machine (C6's runs took 2-3x longer with unchanged code) would otherwise stretch the agent's whole
+    wall-time curve.
+    """
+    return runs.groupby("step").agg(
+        mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "median")
+    )
+
+
 def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None = None) -> list[Path]:
-    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band.
+    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band; the wall-time
+    axis places each evaluation at the seeds' median training time (:func:`mean_curve`).
 
     ``warnings`` (e.g. runs whose budget never reached ``learning_starts``) are printed in red on every figure.
     """
@@ -107,9 +121,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
             )
         for algo, runs in task.groupby("algo"):
-            curve = runs.groupby("step").agg(
-                mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "mean")
-            )
+            curve = mean_curve(runs)
             half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
             for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
                 seeds = int(curve["count"].max())
@@ -119,7 +131,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
         if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
             axes[0].plot([], [], "v", color="grey", label="growth (new bin count)")
         axes[0].set_xlabel("environment steps")
-        axes[1].set_xlabel("training wall time [s]")
+        axes[1].set_xlabel("training wall time [s], median over seeds")
         axes[0].set_ylabel("greedy return (penalized)")
         axes[0].legend(fontsize=8)
         figure.suptitle(f"{env}, action penalty c = {penalty:g} (mean, 95 % CI over seeds)")

@@ -1,4 +1,4 @@
-"""The figures' helpers: degenerate normalization, Q-value snapshots with the bins' action values."""
+"""The figures' helpers: learning-curve statistics, degenerate normalization, Q-value snapshots."""
 
 from pathlib import Path
 
@@ -12,6 +12,7 @@ from sb3_gqn.plots import (
     aggregate,
     clipped_radii,
     degenerate_tasks,
+    mean_curve,
     normalized_final_scores,
     q_value_picture,
     save_q_snapshot,
@@ -86,3 +87,20 @@ def test_iqm_intervals_are_seeded_and_leave_the_global_numpy_stream_alone():
         np.testing.assert_array_equal(again[algo], intervals[algo])
         assert not np.array_equal(other_seed[algo], intervals[algo])
         assert intervals[algo][0, 0] <= estimates[algo][0] <= intervals[algo][1, 0]
+
+
+def test_mean_curve_averages_returns_and_places_each_step_at_the_median_wall_time():
+    """Three seeds, one trained several times slower: the return is their mean, the wall time the middle run's (a mean would
+    put step 200 at 800 s, not 400 s)."""
+    runs = pd.DataFrame(
+        [
+            {"seed": seed, "step": step, "return": value, "wall_time": wall}
+            for seed, values, walls in [(0, (0, 30), (100, 400)), (1, (10, 60), (110, 420)), (2, (20, 90), (300, 1600))]
+            for step, value, wall in zip((100, 200), values, walls)
+        ]
+    )
+    curve = mean_curve(runs)
+    assert list(curve.index) == [100, 200]
+    assert list(curve["mean"]) == [10.0, 60.0] and list(curve["count"]) == [3, 3]
+    assert list(curve["std"]) == [10.0, 30.0]  # sample std of (0, 10, 20) and (30, 60, 90)
+    assert list(curve["wall"]) == [110.0, 420.0]
