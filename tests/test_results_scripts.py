@@ -342,7 +342,7 @@ def test_seed_fill_with_growth_counts_the_fresh_runs_growth_events_and_bins():
     from decision_rules import SeedFill, seed_fill_lines
 
     # C6's form: the shipped pair, earlier seed 0 and fresh seeds 2 and 3 (both agents finished them)
-    fill = SeedFill("C", "E", "a", "gqn-adaptive+x", "a", "decqn-9+x", [0], [2, 3], growth=True)
+    fill = SeedFill("C", "E", "a", "gqn-adaptive+x", "a", "decqn-9+x", [0], [2, 3, 4], growth=True)
     runs = [
         ("gqn-adaptive+x", 0, [100, 0, 600], 9, "15000:3", 0.012),  # earlier seed: its miss (100 -> 0) is not counted
         # seed 2: 2 -> 3 at 15k pairs 200 (10k) with 150 (20k), 75 % of 200, holds; 5 -> 9 at 50k pairs 150 (20k)
@@ -350,15 +350,21 @@ def test_seed_fill_with_growth_counts_the_fresh_runs_growth_events_and_bins():
         ("gqn-adaptive+x", 2, [200, 150, 400], 9, "15000:3 30000:5 50000:9", 0.014),
         # seed 3: 2 -> 3 at 15k, 200 -> 100 is 50 % of 200, misses; it ends at 3 bins
         ("gqn-adaptive+x", 3, [200, 100, 300], 3, "15000:3", 0.010),
-        *[("decqn-9+x", seed, [0, 0, 500], 9, "", 0.011) for seed in (0, 2, 3)],
+        # seed 4: 2 -> 3 at 5k, before the first evaluation (10k): unscored, neither held nor missed; 3 -> 9 at 15k
+        # pairs 0 (10k) with 40 (20k), within 50 of a return below 100, holds
+        ("gqn-adaptive+x", 4, [0, 40, 300], 9, "5000:3 15000:9", 0.013),
+        *[("decqn-9+x", seed, [0, 0, 500], 9, "", 0.011) for seed in (0, 2, 3, 4)],
     ]
     _, missing, lines = seed_fill_lines({"a": _rule_table_with_smoothness(runs)}, fill)
     assert missing == {}
-    # 3 -> 5 at 30k pairs 150 (20k) with 400 (100k) too: 4 events on the fresh seeds, one missed
-    assert lines[-2] == "growth events on the fresh seeds [2, 3]: 3 of 4 hold (misses: seed 3 -> 3 at 15000: 200 -> 100)"
-    assert lines[-1] == "runs at 9 bins: 1 of 2 (seed 2 at 50k); short: seeds [3]"
+    # 3 -> 5 at 30k pairs 150 (20k) with 400 (100k) too: 6 events on the fresh seeds, 5 scored, one missed
+    assert lines[-2] == (
+        "growth events on the fresh seeds [2, 3, 4]: 4 of 5 hold (misses: seed 3 -> 3 at 15000: 200 -> 100); "
+        "1 unscored, before the first evaluation (seed 4 -> 3 at 5000)"
+    )
+    assert lines[-1] == "runs at 9 bins: 2 of 3 (seed 2 at 50k, seed 4 at 15k); short: seeds [3]"
     # without growth=True the same fill reports no growth lines
-    plain = SeedFill("C", "E", "a", "gqn-adaptive+x", "a", "decqn-9+x", [0], [2, 3])
+    plain = SeedFill("C", "E", "a", "gqn-adaptive+x", "a", "decqn-9+x", [0], [2, 3, 4])
     assert not any("growth" in line for line in seed_fill_lines({"a": _rule_table_with_smoothness(runs)}, plain)[2])
 
 

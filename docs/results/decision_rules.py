@@ -470,20 +470,25 @@ SEED_FILLS += [
 
 
 def fresh_growth_lines(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> list[str]:
-    """``algo``'s growth events on ``env`` for ``seeds`` (finished runs): how many hold the collapse criterion, each
-    miss, and the runs at 9 bins with the step each reached them (C6)."""
+    """``algo``'s growth events on ``env`` for ``seeds`` (finished runs): how many of those with an evaluation on
+    both sides hold the collapse criterion, each miss, the unscored ones, and the runs at 9 bins with the step each
+    reached them (C6)."""
     if not seeds:
         return []
     checks = run_growth_checks(table, env, algo, seeds)
     misses = [miss_text(check) for check in checks if check.held is False]
+    # a growth before a run's first evaluation has no "before" to compare with: unscored, neither held nor missed
+    unscored = [f"seed {check.seed} -> {check.bins} at {check.step}" for check in checks if check.held is None]
+    scored = len(checks) - len(unscored)
     finals = finished_runs(table, env)
     finals = finals[(finals["algo"] == algo) & finals["seed"].isin(seeds)]
     nine = {check.seed: check.step for check in checks if check.bins == 9}
     reached = ", ".join(f"seed {seed} at {nine[seed] // 1000}k" for seed in sorted(nine))
     short = sorted(set(finals["seed"].astype(int)) - set(nine))
     return [
-        f"growth events on the fresh seeds {seeds}: {len(checks) - len(misses)} of {len(checks)} hold"
-        + (f" (misses: {'; '.join(misses)})" if misses else ""),
+        f"growth events on the fresh seeds {seeds}: {scored - len(misses)} of {scored} hold"
+        + (f" (misses: {'; '.join(misses)})" if misses else "")
+        + (f"; {len(unscored)} unscored, before the first evaluation ({'; '.join(unscored)})" if unscored else ""),
         f"runs at 9 bins: {len(finals) - len(short)} of {len(finals)} ({reached})"
         + (f"; short: seeds {short}" if short else ""),
     ]
