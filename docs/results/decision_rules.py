@@ -95,12 +95,18 @@ def missing_seeds(final: pd.DataFrame, suffix: str) -> dict[str, list[int]]:
 
 def run_growth_checks(table: pd.DataFrame, env: str, algo: str, seeds: list[int]) -> list[GrowthCheck]:
     """The growth events of ``algo``'s runs on ``env`` with ``seeds``, each with its collapse verdict."""
-    return [check for check in growth_checks(table[table["env"] == env]) if check.algo == algo and check.seed in seeds]
+    runs = table[(table["env"] == env) & (table["algo"] == algo) & table["seed"].isin(seeds)]
+    return growth_checks(runs)
+
+
+def event_text(check: GrowthCheck) -> str:
+    """One growth event: seed, level, step."""
+    return f"seed {check.seed} -> {check.bins} at {check.step}"
 
 
 def miss_text(check: GrowthCheck) -> str:
-    """One growth event that misses the collapse criterion: seed, level, step, the returns around it."""
-    return f"seed {check.seed} -> {check.bins} at {check.step}: {check.before:.0f} -> {check.after:.0f}"
+    """One growth event that misses the collapse criterion, with the returns around it."""
+    return f"{event_text(check)}: {check.before:.0f} -> {check.after:.0f}"
 
 
 def growth_misses(table: pd.DataFrame, env: str, suffix: str, seeds_of: dict[str, list[int]]) -> list[str]:
@@ -478,7 +484,7 @@ def fresh_growth_lines(table: pd.DataFrame, env: str, algo: str, seeds: list[int
     checks = run_growth_checks(table, env, algo, seeds)
     misses = [miss_text(check) for check in checks if check.held is False]
     # a growth before a run's first evaluation has no "before" to compare with: unscored, neither held nor missed
-    unscored = [f"seed {check.seed} -> {check.bins} at {check.step}" for check in checks if check.held is None]
+    unscored = [event_text(check) for check in checks if check.held is None]
     scored = len(checks) - len(unscored)
     finals = finished_runs(table, env)
     finals = finals[(finals["algo"] == algo) & finals["seed"].isin(seeds)]
