@@ -88,6 +88,9 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-9+residual+1update": ("decqn", {"bins": 9, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     "gqn-linear+residual+1update": ("gqn", {"growth": "linear", "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
     "decqn-2+residual+1update": ("decqn", {"bins": 2, "policy_kwargs": RESIDUAL_TORSO, "train_freq": 1}),
+    # probation of opened levels (growth_probation): predict keeps the previous level until a greedy episode over the
+    # new one holds the return, at most 4 evaluations; on the entry's own torso and update ratio
+    "gqn-adaptive+probation": ("gqn", {"growth": "adaptive", "growth_probation": 4}),
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio (POLICY_KWARGS_ADDED)
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive"}),
     "decqn-9+twin": ("decqn", {"bins": 9}),
@@ -142,6 +145,8 @@ COLUMNS = [
     "active_bins",
     "wall_time",
     "growth_events",
+    "deployed_bins",
+    "deployments",
 ]
 
 
@@ -293,6 +298,8 @@ class BenchmarkCallback(BaseCallback):
             "active_bins": getattr(self.model, "active_bins", ""),
             "wall_time": round(self.train_seconds, 2),
             "growth_events": " ".join(f"{step}:{bins}" for step, bins in getattr(self.model, "growth_events", [])),
+            "deployed_bins": getattr(self.model, "deployed_bins", ""),
+            "deployments": " ".join(f"{step}:{bins}" for step, bins in getattr(self.model, "deployments", [])),
         }
         with open(self.run_dir / "curve.csv", "a", newline="") as handle:
             writer = csv.DictWriter(handle, fieldnames=COLUMNS)

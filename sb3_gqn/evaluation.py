@@ -105,6 +105,7 @@ class LearningCurveCallback(BaseCallback):
             "train_seconds": time.perf_counter() - self._start_time - self._eval_time,
             **evaluation.as_dict(),
             "active_bins": getattr(self.model, "active_bins", None),
+            "deployed_bins": getattr(self.model, "deployed_bins", None),  # what predict acted on (growth_probation)
         }
         self.rows.append(row)
         self.logger.record("eval/return", evaluation.return_mean)

@@ -119,6 +119,11 @@ class GQN(OffPolicyAlgorithm):
         (:func:`~sb3_gqn.growth.plateau`), which catches the flat plateaus eq. 4 cannot; ``None``: eq. 4 only
     :param growth_min_improvement: adaptive growth: relative gain over the level's best return that counts
         as an improvement for the plateau rule
+    :param growth_probation: adaptive growth: a level the schedule opens is learned and explored at once, but the
+        deployed greedy policy (``predict``, evaluation, export) keeps the previous level until a greedy evaluation
+        episode over the new one returns at least 70 % of the deployed level's last return
+        (:func:`~sb3_gqn.growth.probation_holds`), or for at most this many evaluations; ``None``: deploy each
+        level when it opens (the paper as written). Levels opened by hand (:meth:`grow`) deploy at once
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -177,6 +182,7 @@ class GQN(OffPolicyAlgorithm):
         growth_returns: str = "evaluation",
         growth_patience: int | None = 2,
         growth_min_improvement: float = 0.05,
+        growth_probation: int | None = None,
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
         policy_kwargs: dict[str, Any] | None = None,
@@ -210,6 +216,8 @@ class GQN(OffPolicyAlgorithm):
         if growth_patience is not None:
             check_int("growth_patience", growth_patience, 1)
         check_number("growth_min_improvement", growth_min_improvement, 0.0)
+        if growth_probation is not None:
+            check_int("growth_probation", growth_probation, 1)
         check_int("stats_window_size", stats_window_size, 1)
         check_choice("growth_returns", growth_returns, RETURN_SOURCES)
         check_choice("growth", growth, GROWTH_SCHEDULES)
@@ -260,8 +268,14 @@ class GQN(OffPolicyAlgorithm):
         self.growth = growth
         self.growth_init = growth_init
         self.growth_level = 0
-        #: ``(env step, active bins)`` of every growth so far (saved with the model; plots mark them)
+        #: ``(env step, active bins)`` of every growth so far: when each level opened for learning and exploration
+        #: (saved with the model; plots mark them)
         self.growth_events: list[tuple[int, int]] = []
+        #: ``(env step, deployed bins)`` of every change of the level ``predict`` acts on (with ``growth_probation``
+        #: after an opened level's probation; otherwise the same as ``growth_events``)
+        self.deployments: list[tuple[int, int]] = []
+        # The level predict() acts on while an opened level is on probation; None: the growth level
+        self._deployed_level: int | None = None
         self.growth_schedule: AdaptiveGrowth | None = None
         if growth == "adaptive":
             self.growth_schedule = AdaptiveGrowth(
@@ -271,6 +285,7 @@ class GQN(OffPolicyAlgorithm):
                 returns_source=growth_returns,
                 patience=growth_patience,
                 min_improvement=growth_min_improvement,
+                probation=growth_probation,
             )
         if _init_setup_model:
             self._setup_model()
@@ -356,21 +371,37 @@ class GQN(OffPolicyAlgorithm):
     # Growth
     @property
     def active_bins(self) -> int:
-        """Current resolution: number of active bins per action dimension."""
+        """Current resolution: number of active bins per action dimension (the level learned and explored)."""
         return self.bin_levels[self.growth_level]
 
-    def _apply_growth_level(self) -> None:
-        """Point the policy's mask and the exploration's choices at the current level."""
-        self._active_bin_indices = active_bin_indices(self.bin_levels[-1], self.active_bins)
-        self.policy.set_active_mask(active_bin_mask(self.bin_levels[-1], self.active_bins))
+    @property
+    def deployed_level(self) -> int:
+        """The level ``predict`` acts on: :attr:`growth_level`, or the previous one while an opened level is on
+        probation (``growth_probation``)."""
+        return self.growth_level if self._deployed_level is None else self._deployed_level
 
-    def grow(self, level: int | None = None, reason: str = "manual") -> None:
+    @property
+    def deployed_bins(self) -> int:
+        """Bins per action dimension ``predict`` (and evaluation, export) chooses from."""
+        return self.bin_levels[self.deployed_level]
+
+    def _apply_growth_level(self) -> None:
+        """Point the masks and the exploration's choices at the current levels: the TD target's max, exploration and
+        training's greedy actions use the growth level; the policy's mask (``predict``) the deployed one."""
+        max_bins = self.bin_levels[-1]
+        self._active_bin_indices = active_bin_indices(max_bins, self.active_bins)
+        self.policy.set_active_mask(active_bin_mask(max_bins, self.deployed_bins))
+        self._learning_bins_mask = th.as_tensor(active_bin_mask(max_bins, self.active_bins), device=self.policy.device)
+
+    def grow(self, level: int | None = None, reason: str = "manual", probation: bool = False) -> None:
         """Open resolution level ``level`` (default: the next one) for every action dimension.
 
         Called by the growth callback; can also be called by hand. Levels never shrink.
 
         :param level: index into :attr:`bin_levels`
         :param reason: text for the log and the console (``verbose >= 1``)
+        :param probation: keep ``predict`` on the deployed level until :meth:`deploy` (the adaptive schedule's
+            probation); by hand (``False``) the level is deployed at once, ending any running probation
         """
         level = self.growth_level + 1 if level is None else int(level)
         if not self.growth_level <= level < len(self.bin_levels):
@@ -384,15 +415,39 @@ class GQN(OffPolicyAlgorithm):
                 self.policy.interpolate_bins(
                     interpolation_neighbours(self.bin_levels[-1], self.bin_levels[step_level - 1], self.bin_levels[step_level])
                 )
+        deployed_level = self.deployed_level
         self.growth_level = level
+        if probation:
+            self._deployed_level = deployed_level
+        else:
+            self._deployed_level = None
+            if self.growth_schedule is not None:
+                self.growth_schedule.end_probation()
         self._apply_growth_level()
         self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
+        if not probation:
+            self.deployments.append((int(self.num_timesteps), int(self.active_bins)))
         if getattr(self, "_logger", None) is not None:  # no logger before the first learn()
             self.logger.record("growth/active_bins", self.active_bins)
+            self.logger.record("growth/deployed_bins", self.deployed_bins)
             self.logger.record("growth/level", self.growth_level)
             self.logger.record("growth/last_growth_step", self.num_timesteps)
         if self.verbose >= 1:
-            print(f"GQN growth: {previous_bins} -> {self.active_bins} bins per dimension ({reason})")
+            on_probation = f"; predict stays at {self.deployed_bins} bins on probation" if probation else ""
+            print(f"GQN growth: {previous_bins} -> {self.active_bins} bins per dimension ({reason}{on_probation})")
+
+    def deploy(self, reason: str = "manual") -> None:
+        """Let ``predict`` act on the growth level (ends a probation; nothing to do without one)."""
+        if self._deployed_level is None:
+            return
+        previous_bins = self.deployed_bins
+        self._deployed_level = None
+        self._apply_growth_level()
+        self.deployments.append((int(self.num_timesteps), int(self.deployed_bins)))
+        if getattr(self, "_logger", None) is not None:
+            self.logger.record("growth/deployed_bins", self.deployed_bins)
+        if self.verbose >= 1:
+            print(f"GQN deployed: predict acts on {previous_bins} -> {self.deployed_bins} bins per dimension ({reason})")
 
     # ----------------------------------------------------------------------------------------------
     # Acting
@@ -419,7 +474,9 @@ class GQN(OffPolicyAlgorithm):
             indices = self._active_bin_indices[np.random.randint(len(self._active_bin_indices), size=shape)]
         else:
             greedy_rows = self.growth_schedule.greedy_envs if self.growth_schedule is not None else None
-            greedy = self.policy.act(self._last_obs)  # type: ignore[arg-type]
+            # greedy over the growth level (the deployed one may still lag behind it on probation)
+            learning_mask = self._learning_bins_mask if self._deployed_level is not None else None
+            greedy = self.policy.act(self._last_obs, learning_mask)  # type: ignore[arg-type]
             indices = epsilon_greedy(
                 greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows, exploration=self.exploration
             )
@@ -437,7 +494,7 @@ class GQN(OffPolicyAlgorithm):
         deterministic: bool = False,
     ) -> tuple[np.ndarray, tuple[np.ndarray, ...] | None]:
         """
-        The env's action for an observation: greedy over the active bins, plus per-dimension
+        The env's action for an observation: greedy over the deployed bins (:attr:`deployed_bins`), plus per-dimension
         epsilon-greedy exploration (``exploration``) when ``deterministic=False``. For a Box env the bins are mapped
         to their continuous values (use ``model.policy.predict`` for the bin indices).
 
@@ -449,8 +506,9 @@ class GQN(OffPolicyAlgorithm):
         """
         actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
         if not deterministic:
+            deployed_indices = active_bin_indices(self.bin_levels[-1], self.deployed_bins)
             actions = epsilon_greedy(
-                np.asarray(actions), self._active_bin_indices, self.exploration_rate, exploration=self.exploration
+                np.asarray(actions), deployed_indices, self.exploration_rate, exploration=self.exploration
             )
         return self.to_env_action(actions), state
 
@@ -475,7 +533,7 @@ class GQN(OffPolicyAlgorithm):
         self.policy.set_training_mode(True)
         # Update learning rate according to schedule
         self._update_learning_rate(self.policy.optimizer)
-        active_bins_mask = self.policy.active_bins_mask
+        active_bins_mask = self._learning_bins_mask  # eq. 3's A^g: the growth level, deployed or on probation
         prioritized = isinstance(self.replay_buffer, PrioritizedSampling)
         if prioritized:
             self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)
@@ -587,7 +645,8 @@ class GQN(OffPolicyAlgorithm):
         )
 
     def _excluded_save_params(self) -> list[str]:
-        return [*super()._excluded_save_params(), "q_net", "q_net_target", "_active_bin_indices", "action_grid"]
+        excluded = ["q_net", "q_net_target", "_active_bin_indices", "_learning_bins_mask", "action_grid"]
+        return [*super()._excluded_save_params(), *excluded]
 
     def _get_torch_save_params(self) -> tuple[list[str], list[str]]:
         return ["policy", "policy.optimizer"], []

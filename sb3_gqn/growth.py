@@ -11,6 +11,9 @@
   ``sigma = 0`` and never falls below ``0.95 mu``).
 * ``growth_init="interpolate"``: :func:`interpolation_neighbours` says which two active bins each
   newly opened bin is warm-started from.
+* ``growth_probation`` (adaptive growth): a level the schedule opens is learned and explored at once, but the
+  deployed greedy policy (``predict``, evaluation, export) keeps the previous level until a greedy episode over the
+  new one holds the return (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
 
 :class:`GrowthCallback` drives either schedule during ``learn()``; GQN installs it itself.
 """
@@ -99,6 +102,20 @@ def plateau(returns: list[float], patience: int, min_improvement: float = 0.05) 
     return max(returns[-patience:]) <= best_before + min_improvement * abs(best_before)
 
 
+def probation_holds(reference: float, candidate: float, tolerance: float = 0.3) -> bool:
+    """Whether a greedy return at a newly opened level holds the deployed level's: ``candidate`` is at least
+    ``reference - tolerance * |reference|`` (70 % of a positive reference by default, 130 % of a negative one).
+
+    ``probation_holds(300, 210)`` is True, ``(300, 209)`` False, ``(-100, -130)`` True, ``(-100, -131)`` False,
+    ``(45, 0)`` False (a policy that stands still after earning 45), ``(0, 0)`` True.
+
+    :param reference: the deployed level's last greedy return (the one the growth was decided on)
+    :param candidate: a greedy return over the opened level
+    :param tolerance: the relative drop that still holds
+    """
+    return candidate >= reference - tolerance * abs(reference)
+
+
 def interpolation_neighbours(max_bins: int, previous_bins: int, active_bins: int) -> list[tuple[int, int, int]]:
     """The bins one growth step opens, each with its two nested neighbours: ``(new, left, right)``.
 
@@ -128,7 +145,8 @@ def linear_growth_level(num_timesteps: int, total_timesteps: int, n_levels: int)
 @dataclass
 class GrowthDecision:
     """Outcome of one adaptive check: the compared return, the eq. 4 threshold (None while the window
-    fills) and, when ``grow``, which rule fired (``"eq. 4"`` or ``"plateau"``)."""
+    fills), when ``grow`` which rule fired (``"eq. 4"`` or ``"plateau"``), and when the return was a probation
+    return (``probation_reference`` set) whether the opened level is deployed."""
 
     current_return: float
     threshold: float | None
@@ -136,12 +154,19 @@ class GrowthDecision:
     window_std: float | None
     grow: bool
     rule: str | None = None
+    deploy: bool = False
+    probation_reference: float | None = None
 
     def describe(self) -> str:
         """One line for the console and the log."""
         if self.rule == "plateau":
             return f"return {self.current_return:.2f} stopped improving (plateau)"
         return f"return {self.current_return:.2f} < eq. 4 threshold {self.threshold:.2f}"
+
+    def describe_probation(self) -> str:
+        """One line for a probation return: held, or deployed after the last allowed try."""
+        held = "holds" if probation_holds(self.probation_reference, self.current_return) else "misses, last try"  # type: ignore[arg-type]
+        return f"probation return {self.current_return:.2f} {held} against {self.probation_reference:.2f}"
 
 
 @dataclass
@@ -166,12 +191,22 @@ class AdaptiveGrowth:
     After a growth both restart, so the new level is judged on its own returns and one dip cannot
     cascade through all levels.
 
+    With ``probation`` (an int), an opened level is learned and explored at once, but the deployed greedy
+    policy keeps the previous level: the evaluation episodes (which act greedily over the opened level) are its
+    probation. The first whose return holds against the deployed level's last return (:func:`probation_holds`),
+    or the ``probation``-th in any case, deploys it (with ``returns_source="training"`` the returns compared are
+    training episodes'). A level opened at the first decision that can grow reaches
+    the deployed policy one evaluation later if it holds. The growth rules themselves are unchanged: probation
+    decides only what ``predict`` acts on.
+
     :param eval_freq: environment steps between evaluations
     :param eval_episodes: greedy episodes averaged into one evaluation return
     :param window: number of past returns in the moving mean and standard deviation
     :param returns_source: ``"evaluation"`` or ``"training"``
     :param patience: returns without improvement before the plateau rule grows (``None``: off)
     :param min_improvement: relative gain that counts as an improvement for the plateau rule
+    :param probation: evaluations over an opened level before it is deployed even if none held (``None``: deploy
+        at opening, the paper as written)
     """
 
     eval_freq: int = 2_500
@@ -180,6 +215,9 @@ class AdaptiveGrowth:
     returns_source: str = "evaluation"
     patience: int | None = 2
     min_improvement: float = 0.05
+    probation: int | None = 4
+    probation_reference: float | None = None
+    probation_tries: int = 0
     history: list[float] = field(default_factory=list)
     level_returns: list[float] = field(default_factory=list)
     next_eval_step: int = 0
@@ -197,6 +235,8 @@ class AdaptiveGrowth:
         if self.patience is not None:
             self.patience = check_int("growth_patience", self.patience, 1)
         self.min_improvement = check_number("growth_min_improvement", self.min_improvement, 0.0)
+        if self.probation is not None:
+            self.probation = check_int("growth_probation", self.probation, 1)
         if self.next_eval_step == 0:
             self.next_eval_step = self.eval_freq
 
@@ -205,7 +245,16 @@ class AdaptiveGrowth:
         state.setdefault("patience", None)
         state.setdefault("min_improvement", 0.05)
         state.setdefault("level_returns", list(state.get("history", [])))
+        # Models saved before probation existed: deployed at opening, as they were trained
+        state.setdefault("probation", None)
+        state.setdefault("probation_reference", None)
+        state.setdefault("probation_tries", 0)
         self.__dict__.update(state)
+
+    @property
+    def on_probation(self) -> bool:
+        """Whether an opened level waits to be deployed."""
+        return self.probation_reference is not None
 
     def start(self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0) -> None:
         """Prepare per-env bookkeeping at the start of ``learn()``.
@@ -252,7 +301,18 @@ class AdaptiveGrowth:
         return decisions
 
     def decide(self, current_return: float) -> GrowthDecision:
-        """Apply eq. 4 over the window and the plateau rule over the level's returns; grow if either fires."""
+        """Apply eq. 4 over the window and the plateau rule over the level's returns; grow if either fires.
+
+        While a level is on probation the return is also its probation return: ``deploy`` when it holds or the
+        tries are used up. The growth rules are the same with or without probation; a growth that happens starts
+        its probation through :meth:`start_probation`.
+        """
+        deploy, reference = False, self.probation_reference
+        if reference is not None:
+            self.probation_tries += 1
+            deploy = probation_holds(reference, current_return) or self.probation_tries >= (self.probation or 1)
+            if deploy:
+                self.probation_reference, self.probation_tries = None, 0
         self.level_returns.append(current_return)
         threshold = window_mean = window_std = None
         rule = None
@@ -269,7 +329,21 @@ class AdaptiveGrowth:
             self.level_returns = []
         else:
             self.history = [*self.history, current_return][-self.window :]
-        return GrowthDecision(current_return, threshold, window_mean, window_std, grow=rule is not None, rule=rule)
+        return GrowthDecision(
+            current_return, threshold, window_mean, window_std, grow=rule is not None, rule=rule, deploy=deploy,
+            probation_reference=reference,
+        )  # fmt: skip
+
+    def start_probation(self, reference: float) -> None:
+        """A level was opened after a decision on ``reference`` (the deployed level's return): its probation starts,
+        unless an earlier opened level is still on probation (then that one's reference and tries carry on, and the
+        first return that holds deploys both)."""
+        if self.probation is not None and self.probation_reference is None:
+            self.probation_reference, self.probation_tries = float(reference), 0
+
+    def end_probation(self) -> None:
+        """Forget a running probation (the level was deployed by other means, e.g. ``model.grow()`` by hand)."""
+        self.probation_reference, self.probation_tries = None, 0
 
     def stop_evaluating(self) -> None:
         """No further levels: stop scheduling greedy episodes."""
@@ -298,7 +372,8 @@ class GrowthCallback(BaseCallback):
 
     def _on_step(self) -> bool:
         model = self.model
-        if model.growth is None or model.growth_level >= len(model.bin_levels) - 1:
+        last_level = len(model.bin_levels) - 1
+        if model.growth is None:
             return True
         if model.growth == "linear":
             target = linear_growth_level(model.num_timesteps, model._total_timesteps, len(model.bin_levels))
@@ -306,7 +381,9 @@ class GrowthCallback(BaseCallback):
                 model.grow(target, reason=f"linear schedule at step {model.num_timesteps}")
             return True
         schedule = model.growth_schedule
-        assert isinstance(schedule, AdaptiveGrowth)
+        assert isinstance(schedule, AdaptiveGrowth), "growth='adaptive' always has its AdaptiveGrowth state"
+        if model.growth_level >= last_level and not schedule.on_probation:
+            return True
         rewards = self.locals["rewards"]
         if model._vec_normalize_env is not None:
             rewards = model._vec_normalize_env.get_original_reward()
@@ -314,11 +391,17 @@ class GrowthCallback(BaseCallback):
             model.logger.record("growth/return", decision.current_return)
             if decision.threshold is not None:
                 model.logger.record("growth/threshold", decision.threshold)
-            if decision.grow and model.growth_level < len(model.bin_levels) - 1:
+            if decision.probation_reference is not None:
+                model.logger.record("growth/probation_return", decision.current_return)
+            if decision.deploy:
+                model.deploy(reason=f"{decision.describe_probation()} at step {model.num_timesteps}")
+            if decision.grow and model.growth_level < last_level:
+                schedule.start_probation(decision.current_return)
                 model.grow(
                     model.growth_level + 1,
                     reason=f"{schedule.returns_source} {decision.describe()} at step {model.num_timesteps}",
+                    probation=schedule.on_probation,
                 )
-                if model.growth_level >= len(model.bin_levels) - 1:
-                    schedule.stop_evaluating()
+            if model.growth_level >= last_level and not schedule.on_probation:
+                schedule.stop_evaluating()
         return True

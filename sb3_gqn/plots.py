@@ -143,11 +143,12 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
     return paths
 
 
-def run_growth_events(runs: pd.DataFrame) -> list[tuple[int, int]]:
-    """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row."""
-    if "growth_events" not in runs or runs.empty:
+def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list[tuple[int, int]]:
+    """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row (``deployments``:
+    the changes of the level its evaluations acted on)."""
+    if column not in runs or runs.empty:
         return []
-    text = runs.sort_values("step")["growth_events"].iloc[-1]
+    text = runs.sort_values("step")[column].iloc[-1]
     if not isinstance(text, str) or not text.strip():
         return []
     return [(int(step), int(bins)) for step, bins in (event.split(":") for event in text.split())]

@@ -184,9 +184,10 @@ class GQNPolicy(BasePolicy):
     def forward(self, obs: PyTorchObs, deterministic: bool = True) -> th.Tensor:
         return self._predict(obs, deterministic=deterministic)
 
-    def _predict(self, obs: PyTorchObs, deterministic: bool = True) -> th.Tensor:
-        """Greedy bin per dimension over the active set (paper eq. 3); shape ``(batch, action_dims)``."""
-        actions = masked_argmax(self.greedy_utilities(obs), self.active_bins_mask)
+    def _predict(self, obs: PyTorchObs, deterministic: bool = True, mask: th.Tensor | None = None) -> th.Tensor:
+        """Greedy bin per dimension over the active set (paper eq. 3), or over ``mask`` when given; shape
+        ``(batch, action_dims)``."""
+        actions = masked_argmax(self.greedy_utilities(obs), self.active_bins_mask if mask is None else mask)
         if self._discrete_actions:
             return actions.squeeze(-1)
         return actions
@@ -241,33 +242,34 @@ class GQNPolicy(BasePolicy):
         """
         return self._mode_dependent
 
-    def act(self, observation: np.ndarray | dict[str, np.ndarray]) -> np.ndarray:
-        """The lean acting path: greedy bins over the active set for a batch of observations.
+    def act(self, observation: np.ndarray | dict[str, np.ndarray], mask: th.Tensor | None = None) -> np.ndarray:
+        """The lean acting path: greedy bins over the active set (or over ``mask``, a boolean tensor of shape
+        ``(max_bins,)`` on the policy's device) for a batch of observations.
 
         ``observation`` is batched as a VecEnv returns it (``(n_envs, *obs_shape)``, or a dict of such arrays);
         the result has shape ``(n_envs, *action_space.shape)``, exactly what :meth:`predict` returns for it, without
         SB3's per-call work that does not apply here (unbatched-input detection, Box clipping, autograd bookkeeping).
         Training (:meth:`~sb3_gqn.GQN._sample_action`) acts through it; :meth:`predict` shares its last step.
         """
-        mask = self.active_bins_mask  # module attributes are looked up once: each lookup costs ~0.4 us here
+        device = self.active_bins_mask.device  # module attributes are looked up once: each lookup costs ~0.4 us here
         q_net = self.q_net
         if isinstance(observation, dict):
-            obs_tensor: PyTorchObs = {key: th.as_tensor(value, device=mask.device) for key, value in observation.items()}
+            obs_tensor: PyTorchObs = {key: th.as_tensor(value, device=device) for key, value in observation.items()}
         elif q_net.flat_vector_observations:
             # The network's float() in NumPy: a fresh float32 array wrapped as is costs ~1 us, torch.as_tensor ~5 us
             obs_tensor = th.from_numpy(np.array(observation, dtype=np.float32))
-            if not mask.is_cpu:
-                obs_tensor = obs_tensor.to(mask.device)
+            if device.type != "cpu":
+                obs_tensor = obs_tensor.to(device)
         else:
-            obs_tensor = th.as_tensor(observation, device=mask.device)
-        return self._greedy_bins(obs_tensor)
+            obs_tensor = th.as_tensor(observation, device=device)
+        return self._greedy_bins(obs_tensor, mask)
 
-    def _greedy_bins(self, obs_tensor: PyTorchObs) -> np.ndarray:
+    def _greedy_bins(self, obs_tensor: PyTorchObs, mask: th.Tensor | None = None) -> np.ndarray:
         """:meth:`_predict`'s greedy bins as a NumPy array ``(batch, *action_space.shape)``, in evaluation mode."""
         if self._mode_dependent:
             self.set_training_mode(False)
         with th.inference_mode():
-            bins = self._predict(obs_tensor)
+            bins = self._predict(obs_tensor, mask=mask)
         return bins.numpy() if bins.is_cpu else bins.cpu().numpy()
 
     def predict(

@@ -84,8 +84,15 @@ def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
         writer.writerows(rows)
 
 
-def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str, growth_events: list[tuple[int, int]]) -> None:
-    """Greedy return and task return over env steps; a dotted line at every growth event."""
+def plot_learning_curve(
+    path: Path,
+    rows: list[dict[str, Any]],
+    title: str,
+    growth_events: list[tuple[int, int]],
+    deployments: list[tuple[int, int]] | None = None,
+) -> None:
+    """Greedy return and task return over env steps; a dotted line at every growth event, and with
+    ``growth_probation`` a dashed one where ``predict`` moved to the opened level (``deployments``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -98,6 +105,10 @@ def plot_learning_curve(path: Path, rows: list[dict[str, Any]], title: str, grow
     for step, bins in growth_events:
         axis.axvline(step, color="grey", alpha=0.4, linestyle=":")
         axis.annotate(f"-> {bins} bins", (step, axis.get_ylim()[0]), rotation=90, fontsize=7, va="bottom")
+    if deployments is not None and list(deployments) != list(growth_events):
+        for step, bins in deployments:
+            axis.axvline(step, color="tab:green", alpha=0.5, linestyle="--")
+            axis.annotate(f"predict {bins}", (step, axis.get_ylim()[1]), rotation=90, fontsize=7, va="top")
     axis.set_xlabel("environment steps")
     axis.set_ylabel("episode return (greedy)")
     axis.set_title(title, fontsize=9)
@@ -138,7 +149,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     model.save(out / "model.zip")
     write_csv(out / "learning_curve.csv", curve.rows)
     plot_learning_curve(
-        out / "learning_curve.png", curve.rows, f"{run_name(args)} (sb3-gqn {__version__})", list(model.growth_events)
+        out / "learning_curve.png",
+        curve.rows,
+        f"{run_name(args)} (sb3-gqn {__version__})",
+        list(model.growth_events),
+        list(model.deployments),
     )
     summary = {
         "run": run_name(args),
@@ -151,6 +166,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "env_steps_per_second": model.num_timesteps / wall_seconds,
         "final_active_bins": model.active_bins,
         "growth_events": [{"step": step, "active_bins": bins} for step, bins in model.growth_events],
+        "deployments": [{"step": step, "deployed_bins": bins} for step, bins in model.deployments],
         "final_evaluation": final.as_dict(),
         "machine": {"python": platform.python_version(), "torch": th.__version__, "threads": th.get_num_threads()},
     }

@@ -97,13 +97,24 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
     policy before the growth: it is the last one *before*, and the first *after* is the next one (at least one
     gradient step at the new level). Without a warm start the opened bins' untrained utilities act at once, so that
     evaluation is the first *after* (the jump the issue calls a collapse).
+
+    A run trained with ``growth_probation`` (its ``deployments`` column differs from its ``growth_events``) changes the
+    policy its evaluations act on only at its deployments: those are checked instead, with an evaluation at a
+    deployment's step counted as *after* (the growth callback deploys before the evaluation callback runs).
     """
     checks = []
     for (algo, env, _, seed), run in table.groupby(["algo", "env", "penalty", "seed"]):
         run = run.sort_values("step")
         steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
-        for step, bins in run_growth_events(run):
-            earlier, later = evaluations_around(steps, step, str(algo))
+        events, deployments = run_growth_events(run), run_growth_events(run, "deployments")
+        # rows written before the deployments existed have no deployed_bins
+        recorded = "deployed_bins" in run and bool(run["deployed_bins"].notna().all())
+        on_probation = recorded and deployments != events
+        for step, bins in deployments if on_probation else events:
+            if on_probation:  # the evaluated policy changed at the deployment: an evaluation at that step acts on it
+                earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
+            else:
+                earlier, later = evaluations_around(steps, step, str(algo))
             checks.append(
                 GrowthCheck(
                     str(algo),

@@ -391,3 +391,38 @@ def test_c4_to_c6_name_the_entries_shipped_today():
         suffix = SHIPPED.get(env, "")
         assert (gqn_entry, decqn_entry) == ("gqn-adaptive" + suffix, "decqn-9" + suffix)
         assert table in MAIN_TABLES and table.startswith(env.removeprefix("dm_control/").removesuffix("-v0"))
+
+
+def test_stand_still_sorts_evaluations_without_task_reward_and_names_the_missed_growths():
+    from stand_still import missed_growths, stand_still, still_kind
+
+    # task return below 5: at rest when the penalty paid is below 1, moving otherwise; 5 itself earned the reward
+    assert still_kind(0.01, 0.0, 5.0, 1.0) == "at rest"
+    assert still_kind(4.9, 359.0, 5.0, 1.0) == "moving"
+    assert still_kind(5.0, 0.0, 5.0, 1.0) is None
+
+    def row(algo: str, seed: int, step: int, value: float, task: float, penalty: float, events: str) -> dict:
+        return {
+            "algo": algo, "env": "dm_control/cartpole-swingup-v0", "penalty": 0.1, "seed": seed, "step": step,
+            "return": value, "task_return": task, "action_penalty": penalty, "growth_events": events,
+        }  # fmt: skip
+
+    table = pd.DataFrame(
+        [
+            # seed 0 grows 2 -> 3 at 19k: 105 at 10k, then 0 at rest at 20k (a miss: more than 30 % down from >= 100)
+            row("gqn-adaptive", 0, 10_000, 105.0, 205.0, 1000.0, ""),
+            row("gqn-adaptive", 0, 20_000, 0.01, 0.01, 0.0, "19000:3"),
+            row("gqn-adaptive", 0, 30_000, 473.0, 497.0, 233.0, "19000:3"),
+            # seed 1 grows at 19k too and holds (300 -> 280 >= 210), then moves without reward at 30k (no growth)
+            row("gqn-adaptive", 1, 10_000, 300.0, 400.0, 1000.0, ""),
+            row("gqn-adaptive", 1, 20_000, 280.0, 300.0, 200.0, "19000:3"),
+            row("gqn-adaptive", 1, 30_000, -30.0, 2.0, 32.0, "19000:3"),
+            row("decqn-9", 0, 10_000, 50.0, 60.0, 10.0, ""),
+        ]
+    )
+    by_algo = {counts.algo: counts for counts in stand_still(table)}
+    assert by_algo["gqn-adaptive"].evaluations == 6
+    assert by_algo["gqn-adaptive"].at_rest == ["0@20k"]
+    assert by_algo["gqn-adaptive"].moving == ["1@30k"]
+    assert (by_algo["decqn-9"].at_rest, by_algo["decqn-9"].moving) == ([], [])
+    assert missed_growths(table) == ["cartpole-swingup-v0 gqn-adaptive seed 0 -> 3 at 19k: 105 -> 0 (at rest)"]
