@@ -119,11 +119,12 @@ class GQN(OffPolicyAlgorithm):
         (:func:`~sb3_gqn.growth.plateau`), which catches the flat plateaus eq. 4 cannot; ``None``: eq. 4 only
     :param growth_min_improvement: adaptive growth: relative gain over the level's best return that counts
         as an improvement for the plateau rule
-    :param growth_probation: adaptive growth: a level the schedule opens is learned and explored at once, but the
-        deployed greedy policy (``predict``, evaluation, export) keeps the previous level until a greedy evaluation
-        episode over the new one returns at least 70 % of the deployed level's last return
-        (:func:`~sb3_gqn.growth.probation_holds`), or for at most this many evaluations; ``None``: deploy each
-        level when it opens (the paper as written). Levels opened by hand (:meth:`grow`) deploy at once
+    :param growth_probation: adaptive growth: a level the schedule opens is explored at once, but greedy actions
+        (in training and in ``predict``) and the TD target's max stay on the deployed level, so the new bins learn
+        "this bin, then the deployed policy" before anything acts on them; the schedule's greedy evaluation episodes
+        act over the opened level, and the first whose return is at least 70 % of the deployed level's last one
+        (:func:`~sb3_gqn.growth.probation_holds`), or the ``growth_probation``-th in any case, deploys it. ``None``:
+        deploy each level when it opens (the paper as written). Levels opened by hand (:meth:`grow`) deploy at once
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -386,8 +387,9 @@ class GQN(OffPolicyAlgorithm):
         return self.bin_levels[self.deployed_level]
 
     def _apply_growth_level(self) -> None:
-        """Point the masks and the exploration's choices at the current levels: the TD target's max, exploration and
-        training's greedy actions use the growth level; the policy's mask (``predict``) the deployed one."""
+        """Point the masks and the exploration's choices at the current levels: exploration and the probation
+        episodes' greedy actions use the growth level; the policy's mask (greedy actions, ``predict``, the TD
+        target's max) the deployed one."""
         max_bins = self.bin_levels[-1]
         self._active_bin_indices = active_bin_indices(max_bins, self.active_bins)
         self.policy.set_active_mask(active_bin_mask(max_bins, self.deployed_bins))
@@ -474,9 +476,12 @@ class GQN(OffPolicyAlgorithm):
             indices = self._active_bin_indices[np.random.randint(len(self._active_bin_indices), size=shape)]
         else:
             greedy_rows = self.growth_schedule.greedy_envs if self.growth_schedule is not None else None
-            # greedy over the growth level (the deployed one may still lag behind it on probation)
-            learning_mask = self._learning_bins_mask if self._deployed_level is not None else None
-            greedy = self.policy.act(self._last_obs, learning_mask)  # type: ignore[arg-type]
+            greedy = self.policy.act(self._last_obs)  # type: ignore[arg-type]
+            if self._deployed_level is not None and greedy_rows is not None and greedy_rows.any():
+                # probation episodes act greedily over the opened level; every other row over the deployed one
+                opened = self.policy.act(self._last_obs, self._learning_bins_mask)  # type: ignore[arg-type]
+                rows = np.asarray(greedy_rows, dtype=bool).reshape((-1,) + (1,) * (greedy.ndim - 1))
+                greedy = np.where(rows, opened, greedy)
             indices = epsilon_greedy(
                 greedy, self._active_bin_indices, self.exploration_rate, greedy_rows=greedy_rows, exploration=self.exploration
             )
@@ -533,7 +538,9 @@ class GQN(OffPolicyAlgorithm):
         self.policy.set_training_mode(True)
         # Update learning rate according to schedule
         self._update_learning_rate(self.policy.optimizer)
-        active_bins_mask = self._learning_bins_mask  # eq. 3's A^g: the growth level, deployed or on probation
+        # Eq. 3's A^g: the deployed level (the growth level unless an opened level is on probation, whose bins then
+        # learn "this bin now, then the deployed policy")
+        active_bins_mask = self.policy.active_bins_mask
         prioritized = isinstance(self.replay_buffer, PrioritizedSampling)
         if prioritized:
             self.replay_buffer.beta = self.importance_sampling_schedule(self._current_progress_remaining)

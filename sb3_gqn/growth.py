@@ -11,9 +11,9 @@
   ``sigma = 0`` and never falls below ``0.95 mu``).
 * ``growth_init="interpolate"``: :func:`interpolation_neighbours` says which two active bins each
   newly opened bin is warm-started from.
-* ``growth_probation`` (adaptive growth): a level the schedule opens is learned and explored at once, but the
-  deployed greedy policy (``predict``, evaluation, export) keeps the previous level until a greedy episode over the
-  new one holds the return (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
+* ``growth_probation`` (adaptive growth): a level the schedule opens is explored at once, but the agent keeps
+  acting greedily and bootstrapping on the deployed level until a greedy episode over the new one holds the return
+  (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
 
 :class:`GrowthCallback` drives either schedule during ``learn()``; GQN installs it itself.
 """
@@ -191,13 +191,13 @@ class AdaptiveGrowth:
     After a growth both restart, so the new level is judged on its own returns and one dip cannot
     cascade through all levels.
 
-    With ``probation`` (an int), an opened level is learned and explored at once, but the deployed greedy
-    policy keeps the previous level: the evaluation episodes (which act greedily over the opened level) are its
-    probation. The first whose return holds against the deployed level's last return (:func:`probation_holds`),
-    or the ``probation``-th in any case, deploys it (with ``returns_source="training"`` the returns compared are
-    training episodes'). A level opened at the first decision that can grow reaches
-    the deployed policy one evaluation later if it holds. The growth rules themselves are unchanged: probation
-    decides only what ``predict`` acts on.
+    With ``probation`` (an int), an opened level is explored at once, but greedy actions and the TD target's max
+    stay on the deployed level (the opened bins learn "this bin, then the deployed policy"): the evaluation
+    episodes, which act greedily over the opened level, are its probation. The first whose return holds against
+    the deployed level's last return (:func:`probation_holds`), or the ``probation``-th in any case, deploys it. A
+    level opened at the first decision that can grow is deployed one evaluation later if it holds. The growth rules
+    read the evaluation returns as without probation. With ``returns_source="training"`` no episode acts greedily
+    over the opened level, so the first training return that holds deploys it (usually the next one).
 
     :param eval_freq: environment steps between evaluations
     :param eval_episodes: greedy episodes averaged into one evaluation return

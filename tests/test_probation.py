@@ -93,28 +93,48 @@ def test_growth_probation_must_be_a_positive_int():
         GQN("MlpPolicy", DecliningEnv(), growth_probation=0, **SMALL)
 
 
-def test_on_probation_predict_acts_on_the_deployed_level_and_learning_on_the_opened_one():
+def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_level():
     model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth_probation=2, **SMALL)
-    model.grow(1, probation=True)  # 2 -> 3 bins opened, predict stays at 2
+    model.grow(1, probation=True)  # 2 -> 3 bins opened, the deployed level stays at 2
     assert (model.active_bins, model.deployed_bins) == (3, 2)
     assert model.policy.active_bins_mask.tolist() == active_bin_mask(9, 2).tolist()
     assert model._learning_bins_mask.tolist() == active_bin_mask(9, 3).tolist()
     assert model._active_bin_indices.tolist() == [0, 4, 8]  # exploration draws from the opened level
-    # make the opened bin 4 the best everywhere: predict must not take it, training's greedy action must
+    # make the opened bin 4 the best everywhere: only the probation episode's row may take it greedily
     with th.no_grad():
-        bias = model.q_net.head.bias.view(3, 9)
-        bias[:, 4] += 100.0
-    observations = np.random.default_rng(0).normal(size=(16, 3)).astype(np.float32)
+        for network in (model.q_net, model.q_net_target):
+            network.head.bias.view(3, 9)[:, 4] += 100.0
+    observations = np.random.default_rng(0).normal(size=(4, 3)).astype(np.float32)
     actions, _ = model.predict(observations, deterministic=True)
     assert set(np.unique(actions)) <= {-1.0, 1.0}
-    assert (model.policy.act(observations, model._learning_bins_mask) == 4).all()
     model._last_obs = observations
     model.exploration_rate = 0.0
-    _, stored = model._sample_action(learning_starts=0, n_envs=16)
-    assert (stored == 4).all()
+    model.growth_schedule.greedy_envs = np.array([False, True, False, False])  # env 1 runs a probation episode
+    _, stored = model._sample_action(learning_starts=0, n_envs=4)
+    assert (stored[1] == 4).all() and not (stored[[0, 2, 3]] == 4).any()
     model.deploy(reason="test")
     assert model.deployed_bins == 3 and model.deployments == [(0, 3)] and model.growth_events == [(0, 3)]
     assert (model.predict(observations, deterministic=True)[0] == 0.0).all()
+
+
+def test_on_probation_the_td_target_maximizes_over_the_deployed_level(monkeypatch):
+    import sb3_gqn.gqn as gqn_module
+
+    model = GQN("MlpPolicy", DecliningEnv(), growth_probation=2, **SMALL)
+    model.learn(150)  # fills the buffer, no growth decision yet (window 3 of 2 500-step evaluations)
+    masks = []
+    original = gqn_module.critic_ensemble_targets
+
+    def recording(*args):
+        masks.append(args[-1].tolist())
+        return original(*args)
+
+    monkeypatch.setattr(gqn_module, "critic_ensemble_targets", recording)
+    model.grow(1, probation=True)
+    model.train(gradient_steps=1, batch_size=32)
+    model.deploy()
+    model.train(gradient_steps=1, batch_size=32)
+    assert masks == [active_bin_mask(9, 2).tolist(), active_bin_mask(9, 3).tolist()]
 
 
 def test_growing_by_hand_deploys_at_once_and_ends_a_probation():

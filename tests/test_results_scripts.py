@@ -426,3 +426,43 @@ def test_stand_still_sorts_evaluations_without_task_reward_and_names_the_missed_
     assert by_algo["gqn-adaptive"].moving == ["1@30k"]
     assert (by_algo["decqn-9"].at_rest, by_algo["decqn-9"].moving) == ([], [])
     assert missed_growths(table) == ["cartpole-swingup-v0 gqn-adaptive seed 0 -> 3 at 19k: 105 -> 0 (at rest)"]
+
+
+def test_probation_screen_counts_an_event_missed_at_its_opening_or_its_deployment():
+    from probation_screen import passes, screen_events
+
+    def row(algo: str, seed: int, step: int, value: float, events: str, deployments: str, deployed: int) -> dict:
+        return {
+            "algo": algo, "env": "E", "penalty": 0.1, "seed": seed, "step": step, "return": value,
+            "task_return": value + 10.0, "growth_events": events, "deployments": deployments, "deployed_bins": deployed,
+        }  # fmt: skip
+
+    table = pd.DataFrame(
+        [
+            # shipped: opened and deployed at 9k; 45 at 7.5k -> 0 at 10k (task return 10) holds (within 50 below 100),
+            # then 5 bins at 21k: 345 -> 113 misses (< 241.5)
+            row("ship", 20, 7_500, 45.0, "", "", 2),
+            row("ship", 20, 10_000, 0.0, "9000:3", "9000:3", 3),
+            row("ship", 20, 20_000, 345.0, "9000:3 21000:5", "9000:3 21000:5", 3),
+            row("ship", 20, 22_500, 113.0, "9000:3 21000:5", "9000:3 21000:5", 5),
+            # probation: opened at 9k (45 -> 33 at 10k, the deployed 2 bins: holds), deployed at 11k (33 -> 299: holds);
+            # opened 5 at 21k: 345 -> 113 at the opening misses although its deployment at 24k holds (113 -> 513)
+            row("prob", 20, 7_500, 45.0, "", "", 2),
+            row("prob", 20, 10_000, 33.0, "9000:3", "", 2),
+            row("prob", 20, 12_500, 299.0, "9000:3", "11000:3", 3),
+            row("prob", 20, 20_000, 345.0, "9000:3", "11000:3", 3),
+            row("prob", 20, 22_500, 113.0, "9000:3 21000:5", "11000:3", 3),
+            row("prob", 20, 25_000, 513.0, "9000:3 21000:5", "11000:3 24000:5", 5),
+            row("prob", 21, 7_500, 100.0, "", "", 2),  # a seed outside the screen is left out
+        ]
+    )
+    by_algo = screen_events(table, [20])
+    assert (by_algo["ship"].events, by_algo["ship"].misses) == (2, ["20 -> 5 at 21k, opening 345 -> 113"])
+    assert (by_algo["prob"].events, by_algo["prob"].misses) == (2, ["20 -> 5 at 21k, opening 345 -> 113"])
+    assert by_algo["ship"].still == [] and by_algo["prob"].share == 0.5
+    # a design passes below half the shipped share (0.5 / 2 = 0.25) without standing still
+    assert not passes(by_algo["prob"], by_algo["ship"])
+    by_algo["prob"].misses = []
+    assert passes(by_algo["prob"], by_algo["ship"])
+    by_algo["prob"].still = ["20@10k"]
+    assert not passes(by_algo["prob"], by_algo["ship"])

@@ -37,7 +37,8 @@ if os.environ.get("PROBE_DELAY"):
             # act greedily (and bootstrap) on the previous level's bins until the delay has passed
             self.policy.set_active_mask(active_bin_mask(self.bin_levels[-1], previous_bins))
             self._probe_switch_step = self.num_timesteps + DELAY
-            print(f"probe: {previous_bins} -> {self.active_bins} opened at {self.num_timesteps}, acted on from {self._probe_switch_step}")
+            opened, switch = self.num_timesteps, self._probe_switch_step
+            print(f"probe: {previous_bins} -> {self.active_bins} opened at {opened}, acted on from {switch}")
 
     def _on_step(self: gqn_module.GQN) -> None:
         original_on_step(self)
