@@ -453,14 +453,16 @@ def test_probation_screen_counts_an_event_missed_at_its_opening_or_its_deploymen
             row("prob", 20, 20_000, 345.0, "9000:3", "11000:3", 3),
             row("prob", 20, 22_500, 113.0, "9000:3 21000:5", "11000:3", 3),
             row("prob", 20, 25_000, 513.0, "9000:3 21000:5", "11000:3 24000:5", 5),
+            # opened 9 at 26k and still on probation at the end: its opening alone is scored, 513 -> 400 holds
+            row("prob", 20, 27_500, 400.0, "9000:3 21000:5 26000:9", "11000:3 24000:5", 5),
             row("prob", 21, 7_500, 100.0, "", "", 2),  # a seed outside the screen is left out
         ]
     )
     by_algo = screen_events(table, [20])
     assert (by_algo["ship"].events, by_algo["ship"].misses) == (2, ["20 -> 5 at 21k, opening 345 -> 113"])
-    assert (by_algo["prob"].events, by_algo["prob"].misses) == (2, ["20 -> 5 at 21k, opening 345 -> 113"])
-    assert by_algo["ship"].still == [] and by_algo["prob"].share == 0.5
-    # a design passes below half the shipped share (0.5 / 2 = 0.25) without standing still
+    assert (by_algo["prob"].events, by_algo["prob"].misses) == (3, ["20 -> 5 at 21k, opening 345 -> 113"])
+    assert by_algo["ship"].still == [] and by_algo["prob"].share == pytest.approx(1 / 3)
+    # a design passes below half the shipped share (0.5 / 2 = 0.25) without standing still: 1/3 does not
     assert not passes(by_algo["prob"], by_algo["ship"])
     by_algo["prob"].misses = []
     assert passes(by_algo["prob"], by_algo["ship"])
