@@ -468,3 +468,32 @@ def test_probation_screen_counts_an_event_missed_at_its_opening_or_its_deploymen
     assert passes(by_algo["prob"], by_algo["ship"])
     by_algo["prob"].still = ["20@10k"]
     assert not passes(by_algo["prob"], by_algo["ship"])
+
+
+def test_r5_verdict_needs_no_miss_nine_bins_deployed_and_a_pooled_mean_within_ten_percent():
+    from probation_screen import PROBATION, Events, R5Task, r5_verdict
+
+    def task(env: str, probation: list[float], shipped: list[float], deployed: list[int], misses: list[str]) -> R5Task:
+        events = {PROBATION: Events(PROBATION, 3, misses), "ship": Events("ship", 3)}
+        finals = {PROBATION: probation, "ship": shipped}
+        return R5Task(env, "ship", list(range(len(probation))), events, finals, finals, deployed)
+
+    # pooled means: probation (800 + 500 + 730) / 3 = 676.67, shipped (770 + 680 + 600) / 3 = 683.33; 90 % of it is
+    # 615, so the return condition holds although finger alone is 26 % down
+    tasks = [
+        task("a/cart", [800.0], [770.0], [9], []),
+        task("a/finger", [500.0], [680.0], [9], []),
+        task("a/walker", [730.0], [600.0], [9], []),
+    ]
+    assert r5_verdict(tasks) == (True, [])
+    # (800 + 500 + 520) / 3 = 606.67 < 615: fails on the return alone
+    tasks[2].final[PROBATION] = [520.0]
+    verdict, reasons = r5_verdict(tasks)
+    assert not verdict and reasons == ["mean final return 607 below 90% of the shipped 683"]
+    tasks[2].final[PROBATION] = [730.0]
+    # one miss, or one run ending with 5 bins deployed, fails it
+    tasks[0].events[PROBATION].misses = ["0 -> 3 at 19k, opening 393 -> 269"]
+    tasks[1].deployed = [5]
+    verdict, reasons = r5_verdict(tasks)
+    assert not verdict and len(reasons) == 2 and "finger seed 0: 5" in reasons[1]
+    assert r5_verdict([]) == (False, [])  # no runs: nothing passes

@@ -86,29 +86,77 @@ def passes(design: Events, shipped: Events) -> bool:
     return design.share < shipped.share / 2 and not design.still
 
 
-def r5_lines(table: pd.DataFrame, env: str, shipped: str, steps: int = 100_000) -> list[str]:
-    """R5 on one task: each finished probation run (events missed, evaluations standing still, bins deployed at the
-    end, final return and SM) beside the shipped entry's run of the same seed, then the means over those seeds."""
+@dataclass
+class R5Task:
+    """R5 on one task: the seeds with a finished probation run and a shipped run, each design's growth events
+    (``screen_events``), final returns and SM by seed, and the probation runs' deployed bins at the end."""
+
+    env: str
+    shipped: str
+    seeds: list[int]
+    events: dict[str, Events]
+    final: dict[str, list[float]]
+    smoothness: dict[str, list[float]]
+    deployed: list[int]
+
+
+def r5_task(table: pd.DataFrame, env: str, shipped: str, steps: int = 100_000) -> R5Task | None:
+    """Collect R5's figures for one task, or ``None`` when no seed has both runs finished."""
     table = table[table["env"] == env]
     finished = table[table["step"] >= steps]
     seeds = sorted(set(finished[finished["algo"] == PROBATION]["seed"]) & set(finished[finished["algo"] == shipped]["seed"]))
     if not seeds:
-        return [f"{env.split('/')[-1]}: no finished {PROBATION} run with a shipped run of its seed"]
+        return None
     runs = table[table["algo"].isin([PROBATION, shipped]) & table["seed"].isin(seeds)]
-    events = screen_events(runs, seeds)
-    lines, means = [], {}
+    final, smoothness = {}, {}
     for algo in (PROBATION, shipped):
-        final = finished[(finished["algo"] == algo) & finished["seed"].isin(seeds)].sort_values("seed")
-        means[algo] = float(final["return"].mean())
-        deployed = final["deployed_bins"].tolist() if "deployed_bins" in final else []
+        rows = finished[(finished["algo"] == algo) & finished["seed"].isin(seeds)].sort_values("seed")
+        final[algo] = rows["return"].astype(float).tolist()
+        smoothness[algo] = rows["smoothness"].astype(float).tolist()
+        if algo == PROBATION:
+            deployed = rows["deployed_bins"].astype(int).tolist() if "deployed_bins" in rows else []
+    return R5Task(env, shipped, [int(seed) for seed in seeds], screen_events(runs, seeds), final, smoothness, deployed)
+
+
+def r5_lines(task: R5Task) -> list[str]:
+    """Each design's line on one task: events missed, evaluations standing still, final return and SM by seed."""
+    lines = []
+    for algo in (PROBATION, task.shipped):
+        events, final = task.events[algo], task.final[algo]
         lines.append(
-            f"{env.split('/')[-1]} {algo} seeds {seeds}: {len(events[algo].misses)} of {events[algo].events} events miss"
-            f" {events[algo].misses}, standing still {events[algo].still or 'never'}; final return "
-            f"{', '.join(f'{value:.0f}' for value in final['return'])} (mean {means[algo]:.0f}), SM "
-            f"{', '.join(f'{value:.4f}' for value in final['smoothness'])}"
-            + (f", deployed bins at the end {deployed}" if algo == PROBATION else "")
+            f"{task.env.split('/')[-1]} {algo} seeds {task.seeds}: {len(events.misses)} of {events.events} events miss"
+            f" {events.misses}, standing still {events.still or 'never'}; final return "
+            f"{', '.join(f'{value:.0f}' for value in final)} (mean {np.mean(final):.0f}), SM "
+            f"{', '.join(f'{value:.4f}' for value in task.smoothness[algo])}"
+            + (f", deployed bins at the end {task.deployed}" if algo == PROBATION else "")
         )
     return lines
+
+
+def r5_verdict(tasks: list[R5Task], max_bins: int = 9, tolerance: float = 0.10) -> tuple[bool, list[str]]:
+    """R5's rule: B goes on to seeds 0-7 of every task iff no probation run misses a growth event, every one has
+    ``max_bins`` deployed at the end, and the mean final return over all probation runs (each run one term, all
+    tasks pooled) is at least ``1 - tolerance`` times the shipped runs' mean on the same seeds. Returns the verdict
+    and the reasons it fails (empty when it passes)."""
+    reasons = []
+    misses = [miss for task in tasks for miss in task.events[PROBATION].misses]
+    if misses:
+        reasons.append(f"{len(misses)} growth events missed: {misses}")
+    short = [
+        f"{task.env.split('/')[-1]} seed {seed}: {bins}"
+        for task in tasks
+        for seed, bins in zip(task.seeds, task.deployed)
+        if bins < max_bins
+    ]
+    if short:
+        reasons.append(f"fewer than {max_bins} bins deployed at the end: {short}")
+    probation = [value for task in tasks for value in task.final[PROBATION]]
+    shipped = [value for task in tasks for value in task.final[task.shipped]]
+    if probation and np.mean(probation) < (1 - tolerance) * np.mean(shipped):
+        reasons.append(
+            f"mean final return {np.mean(probation):.0f} below {1 - tolerance:.0%} of the shipped {np.mean(shipped):.0f}"
+        )
+    return not reasons and bool(probation), reasons
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -127,9 +175,22 @@ def main(argv: list[str] | None = None) -> int:
         for miss in events.misses:
             print(f"  miss: {miss}")
     print("R5 (the tables' protocol):")
+    tasks = []
     for env, (name, shipped_name) in R5_TASKS.items():
-        for line in r5_lines(pd.read_csv(RESULTS / name / "results.csv"), env, shipped_name):
+        task = r5_task(pd.read_csv(RESULTS / name / "results.csv"), env, shipped_name)
+        if task is None:
+            print(f"  {env.split('/')[-1]}: no finished {PROBATION} run with a shipped run of its seed")
+            continue
+        tasks.append(task)
+        for line in r5_lines(task):
             print(f"  {line}")
+    verdict, reasons = r5_verdict(tasks)
+    probation = [value for task in tasks for value in task.final[PROBATION]]
+    shipped = [value for task in tasks for value in task.final[task.shipped]]
+    print(
+        f"R5: {len(probation)} runs, mean final return {np.mean(probation):.0f} vs the shipped entries' {np.mean(shipped):.0f}"
+        f" on the same seeds: {'passes (B goes on to seeds 0-7 of every task)' if verdict else 'fails: ' + '; '.join(reasons)}"
+    )
     return 0
 
 
