@@ -525,7 +525,7 @@ def test_dips_splits_consecutive_evaluation_pairs_by_growth_and_scores_them_with
     )
     found = dips(table, "gqn")
     assert (found.seeds, found.quiet_pairs, found.growth_pairs) == (2, 3, 3)
-    assert found.quiet_failed == ["0@20k 90 -> 30", "0@50k 500 -> 349"]
+    assert found.quiet_failed == ["0@20k 90 -> 30", "0@50k 500 -> 349 (25k after the last growth)"]
     assert found.growth_failed == ["1@30k 400 -> 200"]
     other = dips(table, "other")
     assert (other.quiet_pairs, other.quiet_failed, other.growth_pairs) == (1, ["0@20k 500 -> 0"], 0)

@@ -5,7 +5,8 @@ The bar's no-collapse item scores the pair of evaluations around each growth: th
 same test to every pair of consecutive evaluations of a run and splits the pairs by whether a level opened or was
 deployed between them (a *growth pair*) or not (a *quiet pair*). Static agents (decqn-9) have quiet pairs only, so
 their share of failed quiet pairs is what the criterion gives for learning noise alone; a growing agent's quiet pairs
-say whether it also dips where nothing grows (e.g. at 9 bins, long after its last growth).
+say whether it also dips where nothing grows (e.g. at 9 bins, some evaluations after its last growth; a quiet pair
+that fails says how long after the run's last growth it came).
 
     .venv/bin/python docs/results/dips.py                      # the shipped entries of the three comparison tables
 """
@@ -79,6 +80,9 @@ def dips(table: pd.DataFrame, algo: str) -> Dips:
             grew = any(steps[index - 1] < step <= steps[index] for step in grown)
             failed = not held_after_growth(before, after)
             text = f"{seed}@{steps[index] / 1000:g}k {before:.0f} -> {after:.0f}"
+            earlier = [step for step in grown if step <= steps[index - 1]]
+            if not grew and earlier:  # how long after the run's last growth a quiet pair comes
+                text += f" ({(steps[index] - earlier[-1]) / 1000:g}k after the last growth)"
             if grew:
                 result.growth_pairs += 1
                 result.growth_failed += [text] if failed else []
