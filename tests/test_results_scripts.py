@@ -162,9 +162,16 @@ def test_evaluation_drops_count_pairs_after_the_last_growth_only():
         + run("decqn", [0, 50, 80, 20, 60, 100], "")
     )
     by_algo = {drops.algo: drops for drops in evaluation_drops(table, start=30_000)}
-    assert (by_algo["gqn"].pairs, by_algo["gqn"].drops) == (1, ["0@60k 340 -> 200"])
+    assert (by_algo["gqn"].pairs, by_algo["gqn"].drops) == (1, ["0@60k 340 -> 200 (20k after the last growth)"])
     assert (by_algo["decqn"].pairs, by_algo["decqn"].drops) == (3, ["0@40k 80 -> 20"])
     assert by_algo["decqn"].share == pytest.approx(1 / 3)
+
+    # with growth_probation the acting level changes at its deployments: 5 bins opened at 20k and deployed at 35k,
+    # so the pairs start after 35k (40k -> 50k holds, 50k -> 60k: 500 -> 300 drops, 25k after the deployment)
+    probation = pd.DataFrame(run("gqn+probation", [10, 100, 300, 400, 500, 300], "20000:5"))
+    probation["deployments"] = "35000:5"
+    found = evaluation_drops(probation, start=30_000)[0]
+    assert (found.pairs, found.drops) == (2, ["0@60k 500 -> 300 (25k after the last growth)"])
 
 
 def test_probe_rule_clauses_on_hand_made_tables():
@@ -497,35 +504,3 @@ def test_r5_verdict_needs_no_miss_nine_bins_deployed_and_a_pooled_mean_within_te
     verdict, reasons = r5_verdict(tasks)
     assert not verdict and len(reasons) == 2 and "finger seed 0: 5" in reasons[1]
     assert r5_verdict([]) == (False, [])  # no runs: nothing passes
-
-
-def test_dips_splits_consecutive_evaluation_pairs_by_growth_and_scores_them_with_the_collapse_criterion():
-    from dips import dips
-
-    def row(algo: str, seed: int, step: int, value: float, events: str, deployments: str = "") -> dict:
-        return {"algo": algo, "seed": seed, "step": step, "return": value, "growth_events": events, "deployments": deployments}
-
-    table = pd.DataFrame(
-        [
-            # seed 0: 10k -> 20k quiet, 90 -> 30 fails (below 100: more than 50 down); 20k -> 30k around the opening at
-            # 25k, 30 -> 0 holds; 30k -> 40k quiet, 0 -> 500 holds; 40k -> 50k quiet,
-            # 500 -> 349 fails (< 350)
-            row("gqn", 0, 10_000, 90.0, ""),
-            row("gqn", 0, 20_000, 30.0, ""),
-            row("gqn", 0, 30_000, 0.0, "25000:3"),
-            row("gqn", 0, 40_000, 500.0, "25000:3"),
-            row("gqn", 0, 50_000, 349.0, "25000:3"),
-            # seed 1: opened at 15k, deployed at 28k: both pairs around them are growth pairs; 400 -> 200 fails there
-            row("gqn", 1, 10_000, 300.0, "", ""),
-            row("gqn", 1, 20_000, 400.0, "15000:5", ""),
-            row("gqn", 1, 30_000, 200.0, "15000:5", "28000:5"),
-            row("other", 0, 10_000, 500.0, ""),
-            row("other", 0, 20_000, 0.0, ""),
-        ]
-    )
-    found = dips(table, "gqn")
-    assert (found.seeds, found.quiet_pairs, found.growth_pairs) == (2, 3, 3)
-    assert found.quiet_failed == ["0@20k 90 -> 30", "0@50k 500 -> 349 (25k after the last growth)"]
-    assert found.growth_failed == ["1@30k 400 -> 200"]
-    other = dips(table, "other")
-    assert (other.quiet_pairs, other.quiet_failed, other.growth_pairs) == (1, ["0@20k 500 -> 0"], 0)

@@ -44,22 +44,33 @@ class Drops:
         return len(self.drops) / self.pairs if self.pairs else float("nan")
 
 
+def last_policy_change(run: pd.DataFrame) -> int:
+    """Step of the run's last growth, or of its last deployment where it trained with ``growth_probation`` (the
+    ``deployments`` column: the level its evaluations acted on changed then); -1 for a run that never grew."""
+    events = run_growth_events(run) + run_growth_events(run, column="deployments")
+    return max((step for step, _ in events), default=-1)
+
+
 def evaluation_drops(table: pd.DataFrame, start: int) -> list[Drops]:
-    """Per (env, algo): consecutive evaluations of each run, both after the run's last growth and at or after
-    ``start``, and those where the later one misses ``held_after_growth`` against the earlier one."""
+    """Per (env, algo): consecutive evaluations of each run, both after the run's last growth (or deployment) and at
+    or after ``start``, and those where the later one misses ``held_after_growth`` against the earlier one (as
+    ``seed@step before -> after``, with how long after the last growth the drop came for a run that grew)."""
     result = []
     for (env, algo), runs in table.groupby(["env", "algo"]):
         drops = Drops(str(env), str(algo))
         for seed, run in runs.groupby("seed"):
             run = run.sort_values("step")
             steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
-            last_growth = max((step for step, _ in run_growth_events(run)), default=-1)
+            last_growth = last_policy_change(run)
             _, after_last_growth = evaluations_around(steps, last_growth, str(algo))
             usable = after_last_growth[steps[after_last_growth] >= start]
             for earlier, later in itertools.pairwise(usable):
                 drops.pairs += 1
                 if not held_after_growth(returns[earlier], returns[later]):
-                    drops.drops.append(f"{seed}@{steps[later] // 1000}k {returns[earlier]:.0f} -> {returns[later]:.0f}")
+                    text = f"{seed}@{steps[later] // 1000}k {returns[earlier]:.0f} -> {returns[later]:.0f}"
+                    if last_growth >= 0:
+                        text += f" ({(steps[later] - last_growth) / 1000:g}k after the last growth)"
+                    drops.drops.append(text)
         result.append(drops)
     return result
 
