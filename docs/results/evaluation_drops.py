@@ -51,6 +51,43 @@ def last_policy_change(run: pd.DataFrame) -> int:
     return max((step for step, _ in events), default=-1)
 
 
+@dataclass(frozen=True)
+class EvaluationPair:
+    """Two consecutive evaluations of one run, both after its last growth (or deployment)."""
+
+    seed: int
+    earlier_step: int
+    later_step: int
+    earlier_return: float
+    later_return: float
+    last_growth: int  # -1: the run never grew
+
+    @property
+    def held(self) -> bool:
+        return held_after_growth(self.earlier_return, self.later_return)
+
+    def __str__(self) -> str:
+        text = f"{self.seed}@{self.later_step // 1000}k {self.earlier_return:.0f} -> {self.later_return:.0f}"
+        if self.last_growth >= 0:
+            text += f" ({(self.later_step - self.last_growth) / 1000:g}k after the last growth)"
+        return text
+
+
+def pairs_after_last_growth(run: pd.DataFrame, algo: str, start: int) -> list[EvaluationPair]:
+    """Consecutive evaluations of one run (one seed's rows) that both come after the run's last growth (or
+    deployment; ``evaluations_around`` says which evaluation a growth can have changed) and at or after ``start``."""
+    run = run.sort_values("step")
+    steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
+    seed = int(run["seed"].iloc[0])
+    last_growth = last_policy_change(run)
+    _, after_last_growth = evaluations_around(steps, last_growth, algo)
+    usable = after_last_growth[steps[after_last_growth] >= start]
+    return [
+        EvaluationPair(seed, int(steps[earlier]), int(steps[later]), returns[earlier], returns[later], last_growth)
+        for earlier, later in itertools.pairwise(usable)
+    ]
+
+
 def evaluation_drops(table: pd.DataFrame, start: int) -> list[Drops]:
     """Per (env, algo): consecutive evaluations of each run, both after the run's last growth (or deployment) and at
     or after ``start``, and those where the later one misses ``held_after_growth`` against the earlier one (as
@@ -58,19 +95,10 @@ def evaluation_drops(table: pd.DataFrame, start: int) -> list[Drops]:
     result = []
     for (env, algo), runs in table.groupby(["env", "algo"]):
         drops = Drops(str(env), str(algo))
-        for seed, run in runs.groupby("seed"):
-            run = run.sort_values("step")
-            steps, returns = run["step"].to_numpy(), run["return"].to_numpy(dtype=float)
-            last_growth = last_policy_change(run)
-            _, after_last_growth = evaluations_around(steps, last_growth, str(algo))
-            usable = after_last_growth[steps[after_last_growth] >= start]
-            for earlier, later in itertools.pairwise(usable):
-                drops.pairs += 1
-                if not held_after_growth(returns[earlier], returns[later]):
-                    text = f"{seed}@{steps[later] // 1000}k {returns[earlier]:.0f} -> {returns[later]:.0f}"
-                    if last_growth >= 0:
-                        text += f" ({(steps[later] - last_growth) / 1000:g}k after the last growth)"
-                    drops.drops.append(text)
+        for _, run in runs.groupby("seed"):
+            pairs = pairs_after_last_growth(run, str(algo), start)
+            drops.pairs += len(pairs)
+            drops.drops += [str(pair) for pair in pairs if not pair.held]
         result.append(drops)
     return result
 
