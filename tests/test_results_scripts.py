@@ -504,3 +504,50 @@ def test_r5_verdict_needs_no_miss_nine_bins_deployed_and_a_pooled_mean_within_te
     verdict, reasons = r5_verdict(tasks)
     assert not verdict and len(reasons) == 2 and "finger seed 0: 5" in reasons[1]
     assert r5_verdict([]) == (False, [])  # no runs: nothing passes
+
+
+def test_drop_trace_scores_reading_h_inside_each_pair_against_its_baseline():
+    from drop_trace import score_pairs, verdict
+
+    # one run, last growth at 20k; evaluations every 10k: 30k -> 40k holds (600 -> 620), 40k -> 50k drops
+    # (620 -> 300 < 434), 50k -> 60k holds (300 -> 500)
+    steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
+    table = pd.DataFrame(
+        {
+            "algo": "gqn-adaptive",
+            "seed": 7,
+            "step": steps,
+            "return": [100, 400, 600, 620, 300, 500],
+            "growth_events": "5000:3 10000:5 20000:9",
+        }
+    )
+    trace_steps = list(range(21_000, 61_000, 1_000))
+    share = [0.10] * len(trace_steps)
+    margin = [0.0] * len(trace_steps)
+    # inside the drop's window (40k, 50k] the newest level's share reaches 0.30 and its margin 0.05; the baseline
+    # (30k, 40k] has at most 0.10 and 0.0; inside (30k, 40k] (the first pair) the share rises to 0.12 but the
+    # margin does not: H fails there
+    share[trace_steps.index(45_000)], margin[trace_steps.index(46_000)] = 0.30, 0.05
+    share[trace_steps.index(35_000)] = 0.12
+    trace = pd.DataFrame({"step": trace_steps, "greedy_l3": share, "margin_l3": margin})
+    for column in ["greedy_l0", "greedy_l1", "greedy_l2", "churn", "q_greedy"]:
+        trace[column] = 0.0
+    scored = score_pairs(table, {7: trace}, start=30_000)
+    assert [(item.pair.earlier_step, item.pair.held, item.reading_holds) for item in scored] == [
+        (30_000, True, False),
+        (40_000, False, True),
+        # (50k, 60k]: the baseline (40k, 50k] holds the 0.30 and 0.05, the window 0.10 and 0.0: H fails
+        (50_000, True, False),
+    ]
+    assert scored[0].share_rose and not scored[0].margin_rose
+    assert verdict(scored).startswith("inconclusive")  # one drop only
+    # two drops where H holds and two holding pairs where it does not: supported; H at both holding pairs too: mixed
+    drop, calm = scored[1], scored[0]
+    assert verdict([drop, drop, calm, calm]).startswith("supported: H holds at 2 of 2 drops and at 0 of 2")
+    assert verdict([drop, drop, scored[2], scored[2]]).startswith("supported")
+    # H also at 2 of 3 holding pairs (more than a quarter): not specific to the drops, mixed
+    calm_with_h = type(drop)(calm.pair, drop.window, drop.baseline)
+    assert verdict([drop, drop, calm_with_h, calm_with_h, calm]).startswith("mixed: H holds at 2 of 2 drops and at 2 of 3")
+    failing_drop = type(drop)(drop.pair, drop.baseline, drop.window)  # window and baseline swapped: H fails
+    assert verdict([failing_drop, failing_drop, calm]).startswith("not supported: H holds at 0 of 2 drops")
+    assert verdict([drop, failing_drop, calm]).startswith("mixed: H holds at 1 of 2 drops")

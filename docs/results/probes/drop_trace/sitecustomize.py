@@ -22,7 +22,7 @@ observations (at most 1 024 of them, evenly spaced) and writes a row to ``PROBE_
 
 Without ``PROBE_TRACE_DIR`` in the environment it does nothing. Runs (from the repository root)::
 
-    PYTHONPATH=docs/results/probes/drop_trace PROBE_TRACE_DIR=docs/results/probes/drop_trace/cartpole \\
+    PYTHONPATH=docs/results/probes/drop_trace PROBE_TRACE_DIR=docs/results/probes/drop_trace/cartpole/trace \\
         python -m sb3_gqn.benchmark --algos gqn-adaptive --envs dm_control/cartpole-swingup-v0 --penalties 0.1 \\
         --seeds 30 31 --steps 100000 --eval-freq 2500 --eval-episodes 3 --jobs 1 --threads 1 --no-plots \\
         --out docs/results/probes/drop_trace/cartpole
