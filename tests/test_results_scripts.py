@@ -507,7 +507,7 @@ def test_r5_verdict_needs_no_miss_nine_bins_deployed_and_a_pooled_mean_within_te
 
 
 def test_drop_trace_scores_reading_h_inside_each_pair_against_its_baseline():
-    from drop_trace import score_pairs, verdict
+    from drop_trace import rises, score_pairs, verdict
 
     # one run, last growth at 20k; evaluations every 10k: 30k -> 40k holds (600 -> 620), 40k -> 50k drops
     # (620 -> 300 < 434), 50k -> 60k holds (300 -> 500)
@@ -540,6 +540,8 @@ def test_drop_trace_scores_reading_h_inside_each_pair_against_its_baseline():
         (50_000, True, False),
     ]
     assert scored[0].share_rose and not scored[0].margin_rose
+    # greedy_l3 rose in the drop's window and in the first pair's, not in the last: 1 of 1 drops, 1 of 2 holding
+    assert rises(scored, "greedy_l3") == (1, 1, 1, 2)
     assert verdict(scored).startswith("inconclusive")  # one drop only
     # two drops where H holds and two holding pairs where it does not: supported; H at both holding pairs too: mixed
     drop, calm = scored[1], scored[0]

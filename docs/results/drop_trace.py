@@ -36,15 +36,17 @@ class ScoredPair:
     window: pd.DataFrame
     baseline: pd.DataFrame
 
-    @property
-    def share_rose(self) -> bool:
-        column = f"greedy_l{NEWEST}"
+    def rose(self, column: str) -> bool:
+        """Whether the trace column's maximum in the window exceeds its maximum over the baseline."""
         return bool(self.window[column].max() > self.baseline[column].max())
 
     @property
+    def share_rose(self) -> bool:
+        return self.rose(f"greedy_l{NEWEST}")
+
+    @property
     def margin_rose(self) -> bool:
-        column = f"margin_l{NEWEST}"
-        return bool(self.window[column].max() > self.baseline[column].max())
+        return self.rose(f"margin_l{NEWEST}")
 
     @property
     def reading_holds(self) -> bool:
@@ -96,6 +98,14 @@ def verdict(scored: list[ScoredPair]) -> str:
     return f"mixed: {counts}"
 
 
+def rises(scored: list[ScoredPair], column: str) -> tuple[int, int, int, int]:
+    """How often ``column`` rose above its baseline maximum: ``(at drops, drops, at holding pairs, holding pairs)``
+    (an exploratory count, not part of D1's verdict)."""
+    drops = [item for item in scored if not item.pair.held]
+    held = [item for item in scored if item.pair.held]
+    return sum(item.rose(column) for item in drops), len(drops), sum(item.rose(column) for item in held), len(held)
+
+
 def read_traces(folder: Path) -> dict[int, pd.DataFrame]:
     """The probe's trace of every seed in ``folder`` (files ``<env>_<seed>.csv`` under ``folder/trace``)."""
     traces = {}
@@ -108,6 +118,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folder", type=Path, default=FOLDER, help="the runner's --out of the traced runs")
     parser.add_argument("--start", type=int, default=30_000, help="first evaluation step a pair may use")
+    parser.add_argument(
+        "--columns",
+        nargs="+",
+        default=["greedy_l0", "greedy_l1", "greedy_l2", "greedy_l3", "margin_l3", "churn", "q_greedy", "q_target_gap"],
+        help="trace columns whose rises to count at drops and at holding pairs",
+    )
     args = parser.parse_args(argv)
     table = pd.read_csv(args.folder / "results.csv")
     scored = score_pairs(table, read_traces(args.folder), args.start)
@@ -116,6 +132,10 @@ def main(argv: list[str] | None = None) -> int:
         if not item.pair.held:
             print(f"  drop {item.describe()}")
     print(f"D1: {verdict(scored)}")
+    print("exploratory, not pre-stated: a trace column's window maximum above its baseline maximum")
+    for column in args.columns:
+        at_drops, drops, at_held, held = rises(scored, column)
+        print(f"  {column:14s} at {at_drops} of {drops} drops, at {at_held} of {held} pairs that hold")
     return 0
 
 
