@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -82,28 +83,31 @@ def score_pairs(table: pd.DataFrame, traces: dict[int, pd.DataFrame], start: int
     return scored
 
 
-def verdict(scored: list[ScoredPair]) -> str:
-    """D1's verdict on reading H from the scored pairs (drops: pairs whose later evaluation fails the criterion)."""
+def counts(scored: list[ScoredPair], holds: Callable[[ScoredPair], bool]) -> tuple[int, int, int, int]:
+    """How often ``holds`` is true: ``(at drops, drops, at holding pairs, holding pairs)`` (a drop: a pair whose later
+    evaluation fails the criterion)."""
     drops = [item for item in scored if not item.pair.held]
     held = [item for item in scored if item.pair.held]
-    at_drops = sum(item.reading_holds for item in drops)
-    at_held = sum(item.reading_holds for item in held)
-    counts = f"H holds at {at_drops} of {len(drops)} drops and at {at_held} of {len(held)} pairs that hold"
-    if len(drops) < 2:
-        return f"inconclusive (fewer than 2 drops): {counts}"
-    if at_drops > len(drops) / 2 and at_held <= len(held) / 4:
-        return f"supported: {counts}"
-    if at_drops <= len(drops) / 4:
-        return f"not supported: {counts}"
-    return f"mixed: {counts}"
+    return sum(map(holds, drops)), len(drops), sum(map(holds, held)), len(held)
+
+
+def verdict(scored: list[ScoredPair]) -> str:
+    """D1's verdict on reading H from the scored pairs."""
+    at_drops, drops, at_held, held = counts(scored, lambda item: item.reading_holds)
+    text = f"H holds at {at_drops} of {drops} drops and at {at_held} of {held} pairs that hold"
+    if drops < 2:
+        return f"inconclusive (fewer than 2 drops): {text}"
+    if at_drops > drops / 2 and at_held <= held / 4:
+        return f"supported: {text}"
+    if at_drops <= drops / 4:
+        return f"not supported: {text}"
+    return f"mixed: {text}"
 
 
 def rises(scored: list[ScoredPair], column: str) -> tuple[int, int, int, int]:
-    """How often ``column`` rose above its baseline maximum: ``(at drops, drops, at holding pairs, holding pairs)``
-    (an exploratory count, not part of D1's verdict)."""
-    drops = [item for item in scored if not item.pair.held]
-    held = [item for item in scored if item.pair.held]
-    return sum(item.rose(column) for item in drops), len(drops), sum(item.rose(column) for item in held), len(held)
+    """How often ``column`` rose above its baseline maximum, as :func:`counts` (exploratory, not part of D1's
+    verdict)."""
+    return counts(scored, lambda item: item.rose(column))
 
 
 def read_traces(folder: Path) -> dict[int, pd.DataFrame]:

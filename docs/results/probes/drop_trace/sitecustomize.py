@@ -39,22 +39,18 @@ if os.environ.get("PROBE_TRACE_DIR"):
 
     import sb3_gqn.gqn as gqn_module
     from sb3_gqn.growth import interpolation_neighbours
-    from sb3_gqn.masking import masked_argmax
+    from sb3_gqn.masking import active_bin_indices, masked_argmax
 
     TRACE_DIR = Path(os.environ["PROBE_TRACE_DIR"])
     FREQ = int(os.environ.get("PROBE_TRACE_FREQ", "1000"))
     RECENT, STATES = 5_000, 1_024
     original_on_step = gqn_module.GQN._on_step
 
-    def bin_levels(levels: list[int]) -> np.ndarray:
-        """Level index at which each bin of the finest level opens."""
-        max_bins = levels[-1]
-        opened = np.full(max_bins, -1)
-        for level, bins in enumerate(levels):
-            stride = (max_bins - 1) // (bins - 1)
-            for index in range(0, max_bins, stride):
-                if opened[index] < 0:
-                    opened[index] = level
+    def opening_levels(levels: list[int]) -> np.ndarray:
+        """Index of the level at which each bin of the finest level opens (its first level's active bins)."""
+        opened = np.full(levels[-1], len(levels))
+        for level, bins in reversed(list(enumerate(levels))):
+            opened[active_bin_indices(levels[-1], bins)] = level
         return opened
 
     def recent_indices(buffer: object, count: int) -> np.ndarray:
@@ -76,7 +72,7 @@ if os.environ.get("PROBE_TRACE_DIR"):
         target_q = policy.q_net_target(obs_tensor).gather(-1, greedy.unsqueeze(-1)).squeeze(-1)
         active = utilities[..., mask]
         utility_range = float((active.max(-1).values - active.min(-1).values).mean())
-        levels = bin_levels(model.bin_levels)
+        levels = opening_levels(model.bin_levels)
         greedy_np = greedy.cpu().numpy()
         taken = buffer.actions[recent_indices(buffer, FREQ), 0].astype(int).reshape(-1)
         row: dict[str, float] = {
