@@ -553,3 +553,58 @@ def test_drop_trace_scores_reading_h_inside_each_pair_against_its_baseline():
     failing_drop = type(drop)(drop.pair, drop.baseline, drop.window)  # window and baseline swapped: H fails
     assert verdict([failing_drop, failing_drop, calm]).startswith("not supported: H holds at 0 of 2 drops")
     assert verdict([drop, failing_drop, calm]).startswith("mixed: H holds at 1 of 2 drops")
+
+
+def test_eval_noise_reads_each_pair_on_three_and_on_ten_episodes():
+    from eval_noise import ReadTwice, read_twice, verdict
+
+    steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
+    runner = pd.DataFrame(
+        {
+            "algo": "gqn-adaptive",
+            "env": "dm_control/cartpole-swingup-v0",
+            "penalty": 0.1,
+            "seed": [5] * 6 + [6] * 6,
+            "step": steps * 2,
+            # seed 5: 620 -> 300 after the last growth drops (300 < 0.7 * 620 = 434); seed 6: the growth to 3 bins at
+            # 15k drops (200 -> 120 < 140)
+            "return": [100, 400, 600, 620, 300, 500, 200, 120, 400, 410, 420, 430],
+            "growth_events": "15000:3 25000:5",
+        }
+    )
+    # the probe's 10 episodes: seed 5 has no row at 60k (that evaluation is left out on both sides); seed 6 drops on
+    # them at 30k -> 40k (400 -> 200 < 280) where its 3 episodes hold
+    more = pd.DataFrame(
+        {
+            "seed": [5] * 5 + [6] * 6,
+            "step": steps[:5] + steps,
+            "return": [90, 150, 610, 600, 500, 210, 190, 400, 200, 420, 430],
+        }
+    )
+    scored = read_twice(runner, more, start=30_000)
+    # warm-started growths: the evaluation at or before the growth step is "before", the next one "after"
+    read = [(item.kind, item.seed, item.earlier_step, item.few, item.more, item.few_drop, item.more_drop) for item in scored]
+    assert read == [
+        ("after last growth", 5, 30_000, (600, 620), (610, 600), False, False),
+        ("after last growth", 5, 40_000, (620, 300), (600, 500), True, False),
+        ("after last growth", 6, 30_000, (400, 410), (400, 200), False, True),
+        ("after last growth", 6, 40_000, (410, 420), (200, 420), False, False),
+        ("after last growth", 6, 50_000, (420, 430), (420, 430), False, False),
+        ("growth -> 3", 5, 10_000, (100, 400), (90, 150), False, False),
+        ("growth -> 5", 5, 20_000, (400, 600), (150, 610), False, False),
+        ("growth -> 3", 6, 10_000, (200, 120), (210, 190), True, False),
+        ("growth -> 5", 6, 20_000, (120, 400), (190, 400), False, False),
+    ]
+    # 2 3-episode drops, neither a 10-episode drop; 1 10-episode drop in all
+    assert verdict(scored).startswith("inconclusive (fewer than 4 3-episode drops): 0 of 2 3-episode drops are")
+    few_only = ReadTwice("after last growth", 1, 0, 1, (600, 100), (600, 590))
+    both = ReadTwice("after last growth", 1, 0, 1, (600, 100), (600, 100))
+    more_only = ReadTwice("after last growth", 1, 0, 1, (600, 590), (600, 100))
+    calm = ReadTwice("after last growth", 1, 0, 1, (600, 590), (600, 590))
+    assert verdict([few_only] * 4 + [calm] * 3).startswith("supported: 0 of 4")
+    # one of four survives (at most a third) and the 10 episodes drop in 2 pairs (half of 4): still supported
+    assert verdict([few_only] * 3 + [both, more_only, calm]).startswith("supported: 1 of 4")
+    # ... but in 3 pairs (more than half): mixed
+    assert verdict([few_only] * 3 + [both, more_only, more_only]).startswith("mixed: 1 of 4")
+    assert verdict([few_only, both, both, both]).startswith("not supported: 3 of 4")
+    assert verdict([few_only, few_only, both, both]).startswith("mixed: 2 of 4")
