@@ -27,19 +27,19 @@ from sb3_gqn.growth import (
     AdaptiveGrowth,
     GrowthCallback,
     bin_levels_from,
-    interpolation_neighbours,
 )
-from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, active_bin_mask, epsilon_greedy
+from sb3_gqn.masking import EXPLORATION_MODES, active_bin_indices, epsilon_greedy
 from sb3_gqn.nstep_dict import NStepDictReplayBuffer
 from sb3_gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.q_network import DecoupledQNetwork
+from sb3_gqn.resolution import GrowingResolution
 from sb3_gqn.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.wrappers import BinGrid
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
-class GQN(OffPolicyAlgorithm):
+class GQN(GrowingResolution, OffPolicyAlgorithm):
     """
     Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose
     resolution grows from coarse to fine during training.
@@ -50,7 +50,8 @@ class GQN(OffPolicyAlgorithm):
     (``linspace(low, high, max_bins)``); the critic always holds all of them and a mask restricts
     greedy actions, exploration and the TD target's max to the active bins (paper eq. 3).
     ``learn()`` installs a :class:`~sb3_gqn.growth.GrowthCallback` that opens the next level
-    according to ``growth``.
+    according to ``growth``; the levels and the moves between them (:meth:`grow`, :meth:`deploy`) are
+    :class:`~sb3_gqn.resolution.GrowingResolution`'s.
 
     The env keeps its own action space: ``predict`` returns continuous actions for a ``Box`` env,
     so SB3's ``evaluate_policy``, ``EvalCallback``, rl-zoo3's ``enjoy`` and video recording work
@@ -367,89 +368,6 @@ class GQN(OffPolicyAlgorithm):
     def _create_aliases(self) -> None:
         self.q_net = self.policy.q_net
         self.q_net_target = self.policy.q_net_target
-
-    # ----------------------------------------------------------------------------------------------
-    # Growth
-    @property
-    def active_bins(self) -> int:
-        """Current resolution: number of active bins per action dimension (the level learned and explored)."""
-        return self.bin_levels[self.growth_level]
-
-    @property
-    def deployed_level(self) -> int:
-        """The level ``predict`` acts on: :attr:`growth_level`, or the previous one while an opened level is on
-        probation (``growth_probation``)."""
-        return self.growth_level if self._deployed_level is None else self._deployed_level
-
-    @property
-    def deployed_bins(self) -> int:
-        """Bins per action dimension ``predict`` (and evaluation, export) chooses from."""
-        return self.bin_levels[self.deployed_level]
-
-    def _apply_growth_level(self) -> None:
-        """Point the masks and the exploration's choices at the current levels: exploration and the probation
-        episodes' greedy actions use the growth level; the policy's mask (greedy actions, ``predict``, the TD
-        target's max) the deployed one."""
-        max_bins = self.bin_levels[-1]
-        self._active_bin_indices = active_bin_indices(max_bins, self.active_bins)
-        self.policy.set_active_mask(active_bin_mask(max_bins, self.deployed_bins))
-        self._learning_bins_mask = th.as_tensor(active_bin_mask(max_bins, self.active_bins), device=self.policy.device)
-
-    def grow(self, level: int | None = None, reason: str = "manual", probation: bool = False) -> None:
-        """Open resolution level ``level`` (default: the next one) for every action dimension.
-
-        Called by the growth callback; can also be called by hand. Levels never shrink.
-
-        :param level: index into :attr:`bin_levels`
-        :param reason: text for the log and the console (``verbose >= 1``)
-        :param probation: keep ``predict`` on the deployed level until :meth:`deploy` (the adaptive schedule's
-            probation); by hand (``False``) the level is deployed at once, ending any running probation
-        """
-        level = self.growth_level + 1 if level is None else int(level)
-        if not self.growth_level <= level < len(self.bin_levels):
-            raise ValueError(f"Cannot grow from level {self.growth_level} to {level} (levels: {self.bin_levels})")
-        if level == self.growth_level:
-            return
-        previous_bins = self.active_bins
-        if self.growth_init == "interpolate":
-            # One nested step at a time, so a jump over several levels interpolates from already warm bins
-            for step_level in range(self.growth_level + 1, level + 1):
-                self.policy.interpolate_bins(
-                    interpolation_neighbours(self.bin_levels[-1], self.bin_levels[step_level - 1], self.bin_levels[step_level])
-                )
-        deployed_level = self.deployed_level
-        self.growth_level = level
-        if probation:
-            self._deployed_level = deployed_level
-        else:
-            self._deployed_level = None
-            if self.growth_schedule is not None:
-                self.growth_schedule.end_probation()
-        self._apply_growth_level()
-        self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
-        if not probation:
-            self.deployments.append((int(self.num_timesteps), int(self.active_bins)))
-        if getattr(self, "_logger", None) is not None:  # no logger before the first learn()
-            self.logger.record("growth/active_bins", self.active_bins)
-            self.logger.record("growth/deployed_bins", self.deployed_bins)
-            self.logger.record("growth/level", self.growth_level)
-            self.logger.record("growth/last_growth_step", self.num_timesteps)
-        if self.verbose >= 1:
-            on_probation = f"; predict stays at {self.deployed_bins} bins on probation" if probation else ""
-            print(f"GQN growth: {previous_bins} -> {self.active_bins} bins per dimension ({reason}{on_probation})")
-
-    def deploy(self, reason: str = "manual") -> None:
-        """Let ``predict`` act on the growth level (ends a probation; nothing to do without one)."""
-        if self._deployed_level is None:
-            return
-        previous_bins = self.deployed_bins
-        self._deployed_level = None
-        self._apply_growth_level()
-        self.deployments.append((int(self.num_timesteps), int(self.deployed_bins)))
-        if getattr(self, "_logger", None) is not None:
-            self.logger.record("growth/deployed_bins", self.deployed_bins)
-        if self.verbose >= 1:
-            print(f"GQN deployed: predict acts on {previous_bins} -> {self.deployed_bins} bins per dimension ({reason})")
 
     # ----------------------------------------------------------------------------------------------
     # Acting

@@ -13,6 +13,7 @@ ALGORITHM_LAYER = [
     "sb3_gqn.targets",
     "sb3_gqn.masking",
     "sb3_gqn.growth",
+    "sb3_gqn.resolution",
     "sb3_gqn.buffers",
     "sb3_gqn.nstep_dict",
     "sb3_gqn.sum_tree",
