@@ -297,6 +297,9 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         self.bin_levels = bin_levels_from(self.bins)
         if not 0 <= self.growth_level < len(self.bin_levels):
             raise ValueError(f"Growth level {self.growth_level} does not exist for bins={self.bins} ({self.bin_levels})")
+        # save() stores the event lists as JSON, which turns their (step, bins) tuples into lists
+        self.growth_events = [(int(step), int(bins)) for step, bins in self.growth_events]
+        self.deployments = [(int(step), int(bins)) for step, bins in self.deployments]
         self._setup_replay_buffer_class()
         # The policy and the replay buffer work on bin indices; the env keeps its own action space.
         check_action_space(self.action_space)

@@ -133,6 +133,9 @@ def test_save_load_round_trip(tmp_path):
 
     loaded = GQN.load(tmp_path / "gqn", env=DecliningEnv())
     assert loaded.growth_level == 2 and loaded.active_bins == 5
+    # the events come back as (step, bins) tuples, as learn() records them (save() writes JSON lists)
+    assert model.growth_events == [(model.num_timesteps, 5)] and loaded.growth_events == model.growth_events
+    assert loaded.deployments == model.deployments == [(model.num_timesteps, 5)]
     assert loaded.policy.active_bins_mask.tolist() == model.policy.active_bins_mask.tolist()
     assert loaded.growth_schedule.history == model.growth_schedule.history
     assert loaded.growth_schedule.next_eval_step == model.growth_schedule.next_eval_step
