@@ -556,7 +556,7 @@ def test_drop_trace_scores_reading_h_inside_each_pair_against_its_baseline():
 
 
 def test_eval_noise_reads_each_pair_on_three_and_on_ten_episodes():
-    from eval_noise import ReadTwice, read_twice, verdict
+    from eval_noise import ReadTwice, failed_episodes, read_twice, verdict
 
     steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
     runner = pd.DataFrame(
@@ -608,3 +608,8 @@ def test_eval_noise_reads_each_pair_on_three_and_on_ten_episodes():
     assert verdict([few_only] * 3 + [both, more_only, more_only]).startswith("mixed: 1 of 4")
     assert verdict([few_only, both, both, both]).startswith("not supported: 3 of 4")
     assert verdict([few_only, few_only, both, both]).startswith("mixed: 2 of 4")
+    # the later evaluation's episodes against 70 % of the earlier 10-episode mean (600 -> 420): 300 and 419 fall below
+    episodes = pd.Series({(1, 1): "300 700 419 420"})
+    pair = ReadTwice("after last growth", 1, 0, 1, (600, 500), (600, 460))
+    assert failed_episodes(episodes, pair) == "; 2 of 4 episodes below"
+    assert failed_episodes(episodes, ReadTwice("after last growth", 2, 0, 1, (600, 500), (600, 460))) == ""  # no row

@@ -133,17 +133,29 @@ def verdict(scored: list[ReadTwice]) -> str:
     return f"mixed: {text}"
 
 
+def failed_episodes(episodes: pd.Series | None, item: ReadTwice) -> str:
+    """How many of the later evaluation's 10 episodes fall below 70 % of the earlier 10-episode mean (descriptive:
+    whether a drop is the policy failing from every start or from some)."""
+    if episodes is None or (item.seed, item.later_step) not in episodes.index:
+        return ""
+    returns = [float(value) for value in str(episodes.loc[(item.seed, item.later_step)]).split()]
+    below = sum(not held_after_growth(item.more[0], value) for value in returns)
+    return f"; {below} of {len(returns)} episodes below"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folder", type=Path, default=FOLDER, help="the runner's --out of the probed runs")
     parser.add_argument("--start", type=int, default=30_000, help="first evaluation step a pair (a) may use")
     args = parser.parse_args(argv)
     table = pd.read_csv(args.folder / "results.csv")
-    scored = read_twice(table, read_more_episodes(args.folder), args.start)
+    more = read_more_episodes(args.folder)
+    scored = read_twice(table, more, args.start)
     print(f"{args.folder}: {table['seed'].nunique()} finished runs, {len(scored)} scored pairs")
+    episodes = more.set_index(["seed", "step"])["returns"] if "returns" in more else None
     for item in scored:
         if item.few_drop or item.more_drop:
-            print(f"  {item}")
+            print(f"  {item}{failed_episodes(episodes, item)}")
     for name, subset in [
         ("(a) after the last growth", [item for item in scored if item.kind == "after last growth"]),
         ("(b) growth events", [item for item in scored if item.kind != "after last growth"]),
