@@ -597,6 +597,8 @@ def test_eval_noise_reads_each_pair_on_three_and_on_ten_episodes():
     ]
     # 2 3-episode drops, neither a 10-episode drop; 1 10-episode drop in all
     assert verdict(scored).startswith("inconclusive (fewer than 4 3-episode drops): 0 of 2 3-episode drops are")
+    with pytest.raises(ValueError, match="one agent on one env"):
+        read_twice(pd.concat([runner, runner.assign(algo="decqn-9")]), more, start=30_000)
     few_only = ReadTwice("after last growth", 1, 0, 1, (600, 100), (600, 590))
     both = ReadTwice("after last growth", 1, 0, 1, (600, 100), (600, 100))
     more_only = ReadTwice("after last growth", 1, 0, 1, (600, 590), (600, 100))

@@ -76,7 +76,10 @@ def with_more_episodes(table: pd.DataFrame, more: pd.DataFrame) -> pd.DataFrame:
 
 def read_twice(table: pd.DataFrame, more: pd.DataFrame, start: int) -> list[ReadTwice]:
     """D2's scored pairs: (a) after the last growth from ``start`` and (b) the growth events, each read on the
-    runner's returns and on the probe's at the same steps (evaluations the probe lacks are left out on both sides)."""
+    runner's returns and on the probe's at the same steps (evaluations the probe lacks are left out on both sides).
+    The probe's files name the env and seed only, so ``table`` must hold one agent on one env."""
+    if table["algo"].nunique() > 1 or table["env"].nunique() > 1:
+        raise ValueError("the probe's rows name no agent or env: give a folder whose results.csv holds one agent on one env")
     few_table = table.merge(more[["seed", "step"]].drop_duplicates(), on=["seed", "step"])[table.columns]
     more_table = with_more_episodes(table, more)
     scored: list[ReadTwice] = []
