@@ -33,7 +33,7 @@ FOLDER = RESULTS / "probes" / "eval_noise" / "cartpole"
 class ReadTwice:
     """One scored pair of evaluations of one run, with its 3-episode and 10-episode returns."""
 
-    kind: str  # "after last growth" or "growth <before bins> -> <bins>"
+    kind: str  # "after last growth" or "growth -> <bins opened>"
     seed: int
     earlier_step: int
     later_step: int
