@@ -615,3 +615,68 @@ def test_eval_noise_reads_each_pair_on_three_and_on_ten_episodes():
     pair = ReadTwice("after last growth", 1, 0, 1, (600, 500), (600, 460))
     assert failed_episodes(episodes, pair) == "; 2 of 4 episodes below"
     assert failed_episodes(episodes, ReadTwice("after last growth", 2, 0, 1, (600, 500), (600, 460))) == ""  # no row
+
+
+def test_polyak_acting_scores_each_variant_on_the_same_pairs():
+    from polyak_acting import VariantReading, read_variant, verdict
+
+    steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
+    runner = pd.DataFrame(
+        {
+            "algo": "gqn-adaptive",
+            "env": "dm_control/cartpole-swingup-v0",
+            "penalty": 0.1,
+            "seed": [5] * 6 + [6] * 6,
+            "step": steps * 2,
+            "return": 0.0,  # the runner's own returns are not read: each variant is scored on its 10 episodes
+            "growth_events": "15000:3 25000:5",
+        }
+    )
+    online = [100, 400, 600, 620, 300, 500, 200, 120, 400, 410, 420, 650]  # seed 5, then seed 6
+    average = [100, 400, 590, 610, 600, 610, 200, 180, 400, 410, 420, 640]
+    episodes = pd.concat(
+        [
+            pd.DataFrame({"seed": [5] * 6 + [6] * 6, "step": steps * 2, "variant": "online", "return": online}),
+            pd.DataFrame({"seed": [5] * 6 + [6] * 6, "step": steps * 2, "variant": "polyak_0.005", "return": average}),
+        ]
+    ).assign(sm=[0.01] * 6 + [0.03] * 6 + [0.02] * 12)
+    read = read_variant(runner, episodes, "online", start=30_000, target=600)
+    # (a) after the last growth (25k; warm-started, so 30k is the first evaluation it changed): 30k->40k, 40k->50k,
+    # 50k->60k per seed; (b) growth to 3 at 15k: 10k -> 20k, to 5 at 25k: 20k -> 30k
+    assert [pair[:4] for pair in read.pairs] == [
+        ("after last growth", 5, 30_000, 40_000),
+        ("after last growth", 5, 40_000, 50_000),
+        ("after last growth", 5, 50_000, 60_000),
+        ("after last growth", 6, 30_000, 40_000),
+        ("after last growth", 6, 40_000, 50_000),
+        ("after last growth", 6, 50_000, 60_000),
+        ("growth -> 3", 5, 10_000, 20_000),
+        ("growth -> 5", 5, 20_000, 30_000),
+        ("growth -> 3", 6, 10_000, 20_000),
+        ("growth -> 5", 6, 20_000, 30_000),
+    ]
+    # 620 -> 300 (< 0.7 * 620 = 434) and 200 -> 120 (< 140) drop
+    assert [pair[1:] for pair in read.drops] == [(5, 40_000, 50_000, 620, 300), (6, 10_000, 20_000, 200, 120)]
+    assert read.final_return == pytest.approx((500 + 650) / 2)
+    assert read.first_reaching == pytest.approx((30_000 + 60_000) / 2)  # 600 at 30k (seed 5), 650 at 60k (seed 6)
+    assert read.final_sm == pytest.approx(0.02)
+    averaged = read_variant(runner, episodes, "polyak_0.005", start=30_000, target=600)
+    assert averaged.drops == []  # 200 -> 180 holds (>= 140)
+    assert averaged.final_return == pytest.approx(625)
+    assert averaged.first_reaching == pytest.approx((40_000 + 60_000) / 2)
+    assert verdict(read, averaged).startswith("inconclusive (fewer than 4 online drops): polyak_0.005 drops in 0 of 10")
+
+    drop = ("after last growth", 1, 0, 1, 600.0, 100.0)
+    calm = ("after last growth", 1, 0, 1, 600.0, 590.0)
+    base = VariantReading("online", [drop] * 4 + [calm] * 4, 800.0, 40_000.0, 0.01)
+
+    def average_with(drops: int, final: float = 784.0, first: float = 45_000.0) -> VariantReading:
+        return VariantReading("polyak_0.005", [drop] * drops + [calm] * (8 - drops), final, first, 0.01)
+
+    # half the drops, 98 % of the final return, 5 000 steps later: supported at every boundary
+    assert verdict(base, average_with(2)).startswith("supported: polyak_0.005 drops in 2 of 8 pairs, online in 4")
+    assert verdict(base, average_with(2, first=45_001.0)).startswith("mixed")
+    assert verdict(base, average_with(2, final=783.9)).startswith("mixed")
+    assert verdict(base, average_with(3)).startswith("not supported")  # three quarters of the online drops
+    with pytest.raises(ValueError, match="one agent on one env"):
+        read_variant(pd.concat([runner, runner.assign(algo="decqn-9")]), episodes, "online", start=30_000, target=600)
