@@ -28,9 +28,7 @@ import shutil
 import sys
 import time
 from collections.abc import Callable
-from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +39,7 @@ from filelock import FileLock
 from stable_baselines3.common.callbacks import BaseCallback
 
 from sb3_gqn.metrics import rollout_figures
+from sb3_gqn.processes import run_in_processes
 
 #: GQN-adaptive as it was before warm start, the plateau rule and shared exploration (issue 11's ablation)
 BEFORE_GROWTH_FIXES: dict[str, Any] = {
@@ -539,21 +538,16 @@ def main(argv: list[str] | None = None) -> int:
         )
     elif pending:
         out.mkdir(parents=True, exist_ok=True)
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-            futures: dict[Future, RunSpec] = {
-                pool.submit(run, spec, out, args.eval_freq, args.eval_episodes, threads): spec for spec in pending
-            }
-            last_report = 0.0
-            while futures:
-                for future in [future for future in futures if future.done()]:
-                    spec = futures.pop(future)
-                    future.result()  # a failed run stops the suite with its error
-                    print(f"finished {spec.name}")
-                if time.monotonic() - last_report > 15:
-                    running = {spec.name: spec for spec in futures.values() if (out / "runs" / spec.name).exists()}
-                    print(_report(specs, out, running, recorded), flush=True)
-                    last_report = time.monotonic()
-                time.sleep(0.5)
+        by_name = {spec.name: spec for spec in pending}
+        run_in_processes(
+            [(spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads)) for spec in pending],
+            jobs,
+            on_finished=lambda name: print(f"finished {name}"),
+            on_wait=lambda names: print(
+                _report(specs, out, {name: by_name[name] for name in names if (out / "runs" / name).exists()}, recorded),
+                flush=True,
+            ),
+        )
     table = collect(specs, out)
     print(f"results table: {table}")
     if not args.no_plots:
