@@ -23,7 +23,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from sb3_gqn.benchmark import RecordedRuns, RunSpec, _report, run
+from sb3_gqn.benchmark import RecordedRuns, _report, run
+from sb3_gqn.variants import RunSpec
 
 #: seconds between progress lines
 REPORT_EVERY = 15.0

@@ -30,7 +30,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from sb3_gqn.benchmark import warm_started
 from sb3_gqn.plots import (
     equal_run_scores,
     final_rows,
@@ -47,6 +46,7 @@ from sb3_gqn.significance import (
     probability_of_improvement,
     seeds_to_resolve,
 )
+from sb3_gqn.variants import warm_started
 
 
 def held_after_growth(before: float, after: float) -> bool:
@@ -92,7 +92,7 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
     evaluation after it that the growth can have changed.
 
     An evaluation at the very step of a growth runs after it (the growth callback runs before every other callback
-    of that step) and with the new bins. With a warm start (:func:`~sb3_gqn.benchmark.warm_started`) each opened
+    of that step) and with the new bins. With a warm start (:func:`~sb3_gqn.variants.warm_started`) each opened
     bin's utility is the mean of its two neighbours', never above the larger, so that evaluation acts exactly as the
     policy before the growth: it is the last one *before*, and the first *after* is the next one (at least one
     gradient step at the new level). Without a warm start the opened bins' untrained utilities act at once, so that

@@ -14,17 +14,8 @@ from pathlib import Path
 import pytest
 
 import sb3_gqn.benchmark as benchmark
-from sb3_gqn.benchmark import (
-    COLUMNS,
-    RunSpec,
-    collect,
-    learning_starts,
-    main,
-    parse_args,
-    penalized_wrappers,
-    untrained_runs,
-    warm_started,
-)
+from sb3_gqn.benchmark import COLUMNS, collect, main, parse_args
+from sb3_gqn.variants import RunSpec, learning_starts, penalized_wrappers, untrained_runs, warm_started
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
@@ -170,7 +161,7 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
 
 
 def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
-    from sb3_gqn.benchmark import ABLATION, BEFORE_GROWTH_FIXES, VARIANTS
+    from sb3_gqn.variants import ABLATION, BEFORE_GROWTH_FIXES, VARIANTS
 
     assert BEFORE_GROWTH_FIXES == {
         "growth": "adaptive",
@@ -193,10 +184,10 @@ def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
 
 def trained(algo: str, env: str) -> dict:
     """The hyperparameters the runner trains ``algo`` with on ``env``: the shipped entry with the variant's overrides."""
-    from sb3_gqn.benchmark import _shipped_entry, run_overrides
+    from sb3_gqn.variants import run_overrides, shipped_entry
 
     zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
-    return {**_shipped_entry(zoo_algo, env), **overrides}
+    return {**shipped_entry(zoo_algo, env), **overrides}
 
 
 def readme_tables():
@@ -211,7 +202,7 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_v
     """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
     residual torso, by rule R1; finger: DecQN's default torso)."""
-    from sb3_gqn.benchmark import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, RESIDUAL_TORSO, run_overrides
+    from sb3_gqn.variants import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, RESIDUAL_TORSO, run_overrides
 
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
@@ -241,7 +232,7 @@ def test_the_torso_variants_differ_from_the_entries_only_in_the_torso():
     """Issue 11 item 5: walker's earlier entry (``+layernorm+1update``) and finger's residual candidate
     (``+residual+1update``) each train the task's shipped entry with the other torso and nothing else changed, so
     their runs compare with the shipped ones seed for seed."""
-    from sb3_gqn.benchmark import REFERENCE_TORSO, RESIDUAL_TORSO
+    from sb3_gqn.variants import REFERENCE_TORSO, RESIDUAL_TORSO
 
     walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
@@ -366,7 +357,7 @@ def test_warm_started_is_every_variant_but_the_cold_ablation():
 def test_two_critics_keep_the_entry_torso():
     """``gqn-adaptive+twin`` adds DecQN's second critic to the entry's own torso (walker's residual one: the reference
     as its experiments run it), not in place of it."""
-    from sb3_gqn.benchmark import added_policy_kwargs
+    from sb3_gqn.variants import added_policy_kwargs
 
     assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
         "dict(residual_layer_norm=True, n_critics=2)"

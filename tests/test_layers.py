@@ -29,6 +29,7 @@ OTHER_LAYERS = [
     "sb3_gqn.train",
     "sb3_gqn.benchmark",
     "sb3_gqn.processes",
+    "sb3_gqn.variants",
     "sb3_gqn.reference_run",
     "sb3_gqn.evaluation",
     "sb3_gqn.metrics",

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 from final_policies import RESULTS, _read, _write, finished_runs, run_key
 
-from sb3_gqn.benchmark import RunSpec
+from sb3_gqn.variants import RunSpec
 
 OUT = RESULTS / "bin_interpolation.csv"
 STEPS, RANDOM_SHARE, FIRST_SEED = 5_000, 0.3, 30_000
@@ -96,7 +96,7 @@ def probe(run_dir: Path, spec: RunSpec) -> list[dict[str, float | str]]:
     import torch as th
 
     from sb3_gqn import GQN
-    from sb3_gqn.benchmark import make_eval_env
+    from sb3_gqn.variants import make_eval_env
     from sb3_gqn.zoo import register
 
     th.set_num_threads(1)

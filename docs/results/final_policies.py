@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sb3_gqn.benchmark import RunSpec
+from sb3_gqn.variants import RunSpec
 
 RESULTS = Path("docs/results")
 OUT = RESULTS / "final_policies.csv"
@@ -63,8 +63,8 @@ def probe(run_dir: Path, spec: RunSpec) -> dict[str, float | str]:
     from stable_baselines3 import SAC
 
     from sb3_gqn import GQN
-    from sb3_gqn.benchmark import make_eval_env, run_overrides
     from sb3_gqn.metrics import bin_usage, control_frequency, episode_figures, rollout_episodes
+    from sb3_gqn.variants import make_eval_env, run_overrides
     from sb3_gqn.zoo import register
 
     th.set_num_threads(1)
