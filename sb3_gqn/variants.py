@@ -66,6 +66,11 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio (POLICY_KWARGS_ADDED)
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive"}),
     "decqn-9+twin": ("decqn", {"bins": 9}),
+    # acting on a Polyak-averaged copy of the online network (acting_tau, rule D3), training unchanged
+    "gqn-adaptive+avg0.005": ("gqn", {"growth": "adaptive", "acting_tau": 0.005}),
+    "gqn-adaptive+avg0.001": ("gqn", {"growth": "adaptive", "acting_tau": 0.001}),
+    "decqn-9+avg0.005": ("decqn", {"bins": 9, "acting_tau": 0.005}),
+    "decqn-9+avg0.001": ("decqn", {"bins": 9, "acting_tau": 0.001}),
 }
 #: Policy keyword arguments a variant adds to its entry's ``policy_kwargs`` (keeping the entry's torso), as the
 #: source of a ``dict(...)`` call like the entries' own

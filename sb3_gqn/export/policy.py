@@ -80,9 +80,11 @@ class DeployedPolicy(nn.Module):
         policy = model.policy
         self.observation_space = policy.observation_space
         self.action_space = model.action_space  # the env's own space (Box, Discrete or MultiDiscrete)
-        self.q_net: DecoupledQNetwork = copy.deepcopy(policy.q_net).cpu().eval()
-        # With n_critics > 1 the greedy action maximizes the critics' element-wise maximum, as in training
-        self.extra_q_nets = nn.ModuleList(copy.deepcopy(critic).cpu().eval() for critic in policy.extra_q_nets)
+        # The networks predict() acts on: the online critics, or their Polyak-averaged copies (``acting_tau``). With
+        # n_critics > 1 the greedy action maximizes the critics' element-wise maximum, as in training
+        first, *others = policy.acting_networks()
+        self.q_net: DecoupledQNetwork = copy.deepcopy(first).cpu().eval()
+        self.extra_q_nets = nn.ModuleList(copy.deepcopy(critic).cpu().eval() for critic in others)
         for parameter in self.parameters():
             parameter.requires_grad_(False)
         self.normalizer = ObservationNormalizer(vec_normalize) if vec_normalize is not None else None
