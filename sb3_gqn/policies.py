@@ -3,6 +3,8 @@ active-bin mask (paper eq. 3)."""
 
 from __future__ import annotations
 
+from collections import OrderedDict
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -248,6 +250,25 @@ class GQNPolicy(BasePolicy):
             )
         )
         return data
+
+    def load_state_dict(self, state_dict: Mapping[str, Any], strict: bool = True, assign: bool = False) -> Any:
+        """``nn.Module``'s, across a change of ``averaged_acting`` (``acting_tau`` set or unset when a model is loaded):
+        a state without the averaged acting networks loads into a policy that keeps them, which then start as copies
+        of the loaded online networks, and a state with them into a policy without them, which drops them."""
+        state = OrderedDict(state_dict)
+        metadata = getattr(state_dict, "_metadata", None)  # module versions, as nn.Module keeps them
+        saved_acting = [key for key in state if key.startswith("acting_q_nets.")]
+        if self.averaged_acting and not saved_acting:
+            online_prefixes = ["q_net.", *(f"extra_q_nets.{index}." for index in range(self.n_critics - 1))]
+            for index, prefix in enumerate(online_prefixes):
+                for key in [key for key in state if key.startswith(prefix)]:
+                    state[f"acting_q_nets.{index}.{key[len(prefix) :]}"] = state[key]
+        elif not self.averaged_acting:
+            for key in saved_acting:
+                del state[key]
+        if metadata is not None:
+            state._metadata = metadata  # type: ignore[attr-defined]
+        return super().load_state_dict(state, strict, assign)
 
     def set_training_mode(self, mode: bool) -> None:
         """Put the online network in training or evaluation mode (the target stays in eval mode).

@@ -120,3 +120,25 @@ def test_without_acting_tau_the_policy_keeps_no_copy():
 def test_acting_tau_outside_0_1_is_refused(acting_tau):
     with pytest.raises((ValueError, TypeError), match="acting_tau"):
         GQN("MlpPolicy", "Pendulum-v1", acting_tau=acting_tau, **SMALL)
+
+
+def test_acting_tau_can_be_set_or_unset_when_a_model_is_loaded(tmp_path):
+    kwargs = {**SMALL, "policy_kwargs": dict(net_arch=[16], n_critics=2)}
+    plain = GQN("MlpPolicy", "Pendulum-v1", train_freq=1, **kwargs)
+    plain.learn(100)
+    plain.save(tmp_path / "plain.zip")
+    # saved without the averaged networks: they start as copies of the loaded online networks, critic by critic
+    averaged = GQN.load(tmp_path / "plain.zip", acting_tau=0.01)
+    assert averaged.acting_tau == 0.01
+    for (online, _), acting in zip(averaged.policy.critics, averaged.policy.acting_q_nets, strict=True):
+        for a, o in zip(acting.parameters(), online.parameters(), strict=True):
+            assert th.equal(a, o)
+    assert not th.equal(averaged.policy.acting_q_nets[0].head.weight, averaged.policy.acting_q_nets[1].head.weight)
+    averaged.set_env(plain.get_env())
+    averaged.learn(50, reset_num_timesteps=False)
+    averaged.save(tmp_path / "averaged.zip")
+    # saved with them, loaded without: predict acts on the online networks again
+    online = GQN.load(tmp_path / "averaged.zip", acting_tau=None)
+    assert len(online.policy.acting_q_nets) == 0
+    observations = np.random.default_rng(2).normal(size=(10, 3)).astype(np.float32)
+    np.testing.assert_array_equal(online.policy.act(observations), averaged.policy.act(observations, online=True))
