@@ -67,8 +67,8 @@ class GQNPolicy(BasePolicy):
         :func:`~sb3_gqn.targets.critic_ensemble_targets`). ``q_net`` and ``q_net_target`` are the first critic's.
     :param averaged_acting: keep a Polyak-averaged copy of every critic's online network (``acting_q_nets``) for
         :meth:`predict` and :meth:`forward` to act on (set by :class:`~sb3_gqn.GQN` from its ``acting_tau``, which
-        also moves the copies after every gradient step); training's own acting path (:meth:`act`) and the TD
-        targets keep using the online networks
+        also moves the copies after every gradient step); training's exploration (``act(..., online=True)``) and the
+        TD targets keep using the online networks
     """
 
     q_net: DecoupledQNetwork
