@@ -26,6 +26,17 @@ def _interrupt(signum: int, frame: FrameType | None) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
+def _terminate_children(deadline_seconds: float = 30.0) -> None:
+    """Terminate every live child process, sweeping until none is left: the pool can still be starting a worker
+    when the first sweep runs."""
+    deadline = time.monotonic() + deadline_seconds
+    while (children := multiprocessing.active_children()) and time.monotonic() < deadline:
+        for child in children:
+            child.terminate()
+        for child in children:
+            child.join(timeout=1.0)
+
+
 def run_in_processes(
     calls: Sequence[tuple[Hashable, Callable[..., Any], tuple[Any, ...]]],
     jobs: int,
@@ -60,11 +71,7 @@ def run_in_processes(
             time.sleep(0.2)
     except BaseException:
         pool.shutdown(wait=False, cancel_futures=True)
-        children = multiprocessing.active_children()
-        for child in children:
-            child.terminate()
-        for child in children:
-            child.join(timeout=30)
+        _terminate_children()
         raise
     finally:
         pool.shutdown(wait=True)
