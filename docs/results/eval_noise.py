@@ -56,10 +56,11 @@ class ReadTwice:
         )
 
 
-def read_more_episodes(folder: Path) -> pd.DataFrame:
-    """The probe's rows of every run in ``folder/more_episodes`` with a ``seed`` column (the file name's suffix)."""
+def read_more_episodes(folder: Path, subfolder: str = "more_episodes") -> pd.DataFrame:
+    """A probe's rows of every run in ``folder/subfolder`` (one ``<env>_<seed>.csv`` per run) with a ``seed`` column
+    (the file name's suffix)."""
     frames = []
-    for path in sorted((folder / "more_episodes").glob("*_*.csv")):
+    for path in sorted((folder / subfolder).glob("*_*.csv")):
         frame = pd.read_csv(path)
         frame["seed"] = int(path.stem.rsplit("_", 1)[1])
         frames.append(frame)

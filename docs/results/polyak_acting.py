@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from eval_noise import with_more_episodes
+from eval_noise import read_more_episodes, with_more_episodes
 from evaluation_drops import pairs_after_last_growth
 
 from sb3_gqn.report import growth_checks, held_after_growth
@@ -43,16 +43,6 @@ class VariantReading:
     @property
     def drops(self) -> list[tuple[str, int, int, int, float, float]]:
         return [pair for pair in self.pairs if not held_after_growth(pair[4], pair[5])]
-
-
-def read_episodes(folder: Path) -> pd.DataFrame:
-    """The probe's rows of every run in ``folder/episodes`` with a ``seed`` column (the file name's suffix)."""
-    frames = []
-    for path in sorted((folder / "episodes").glob("*_*.csv")):
-        frame = pd.read_csv(path)
-        frame["seed"] = int(path.stem.rsplit("_", 1)[1])
-        frames.append(frame)
-    return pd.concat(frames, ignore_index=True)
 
 
 def read_variant(table: pd.DataFrame, episodes: pd.DataFrame, variant: str, start: int, target: float) -> VariantReading:
@@ -119,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--target", type=float, default=600.0, help="the return whose first reaching is compared")
     args = parser.parse_args(argv)
     table = pd.read_csv(args.folder / "results.csv")
-    episodes = read_episodes(args.folder)
+    episodes = read_more_episodes(args.folder, "episodes")
     readings = [read_variant(table, episodes, variant, args.start, args.target) for variant in episodes["variant"].unique()]
     print(f"{args.folder}: {table['seed'].nunique()} finished runs")
     for reading in readings:
