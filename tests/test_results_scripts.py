@@ -680,3 +680,88 @@ def test_polyak_acting_scores_each_variant_on_the_same_pairs():
     assert verdict(base, average_with(3)).startswith("not supported")  # three quarters of the online drops
     with pytest.raises(ValueError, match="one agent on one env"):
         read_variant(pd.concat([runner, runner.assign(algo="decqn-9")]), episodes, "online", start=30_000, target=600)
+
+
+def test_acting_default_reads_both_networks_on_the_same_evaluations(tmp_path: Path):
+    from acting_default import AGENTS, SEEDS_FOR_VERDICT, TASKS, NetworkReading, complete, paired_table, read_network
+    from acting_default import verdict as d4_verdict
+
+    steps = [10_000, 20_000, 30_000, 40_000, 50_000, 60_000]
+    cartpole = "dm_control/cartpole-swingup-v0"
+
+    def rows(algo: str, seed: int, returns: list[float], sms: list[float], events: str) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "algo": algo,
+                "env": cartpole,
+                "penalty": 0.1,
+                "seed": seed,
+                "step": steps,
+                "return": returns,
+                "smoothness": sms,
+                "growth_events": events,
+            }
+        )
+
+    folder = tmp_path / "cartpole"
+    (folder / "online").mkdir(parents=True)
+    sm = [0.02] * 5
+    pd.concat(
+        [
+            rows("gqn-adaptive+avg0.001", 0, [100, 400, 600, 620, 600, 610], [*sm, 0.010], "15000:3 25000:5"),
+            rows("decqn-9+avg0.001", 0, [100, 300, 500, 480, 490, 500], [*sm, 0.012], ""),
+        ]
+    ).to_csv(folder / "results.csv", index=False)
+    rows("gqn-adaptive", 0, [100, 60, 600, 620, 300, 500], [*sm, 0.014], "15000:3 25000:5").to_csv(
+        folder / "online" / "gqn-adaptive__seed0.csv", index=False
+    )
+    pd.concat(
+        [
+            rows("decqn-9", 0, [100, 300, 500, 300, 490, 510], [*sm, 0.011], ""),
+            rows("decqn-9", 1, [900] * 6, [0.0] * 6, ""),  # seed 1 never finished: its probe rows are left out
+        ]
+    ).to_csv(folder / "online" / "decqn-9__seed0.csv", index=False)
+
+    table = paired_table(tmp_path)
+    assert sorted(table.groupby(["algo", "network"]).size().items()) == [
+        (("decqn-9", "average"), 6),
+        (("decqn-9", "online"), 6),
+        (("gqn-adaptive", "average"), 6),
+        (("gqn-adaptive", "online"), 6),
+    ]
+    online = read_network(table, "gqn-adaptive", "online", start=30_000)
+    # growth to 3 at 15k (warm-started: 10k before, 20k after): 100 -> 60 fails (100 is not below 100: 70 % of it
+    # is 70); to 5 at 25k: 60 -> 600 holds; after the last growth from 30k: 620 -> 300 fails (< 434)
+    assert (online.growth_pairs, online.late_pairs) == (2, 3)
+    assert online.growth_failed == ["cartpole-swingup-v0 seed 0 -> 3 bins: 100 -> 60"]
+    assert online.late_failed == ["cartpole-swingup-v0 seed 0 40k -> 50k: 620 -> 300"]
+    assert (online.failed, online.final_return, online.final_sm) == (2, 500, 0.014)
+    average = read_network(table, "gqn-adaptive", "average", start=30_000)
+    assert (average.failed, average.final_return, average.final_sm) == (0, 610, 0.010)
+    decqn_online = read_network(table, "decqn-9", "online", start=30_000)
+    # no growth: every consecutive pair from 30k on is late; 500 -> 300 fails (< 350)
+    assert (decqn_online.runs, decqn_online.growth_pairs, decqn_online.late_pairs) == (1, 0, 3)
+    assert decqn_online.late_failed == ["cartpole-swingup-v0 seed 0 30k -> 40k: 500 -> 300"]
+    assert not complete(table)
+    assert d4_verdict({}, False).startswith("no verdict yet")
+
+    every_run = pd.DataFrame(
+        [(agent, task, seed, "average") for agent in AGENTS for task in TASKS for seed in SEEDS_FOR_VERDICT],
+        columns=["algo", "env", "seed", "network"],
+    )
+    assert complete(every_run) and not complete(every_run.iloc[1:])
+
+    def reading(network: str, failed: int = 1, final: float = 500.0, final_sm: float = 0.01) -> NetworkReading:
+        return NetworkReading("agent", network, 6, 4, ["x"] * failed, 10, [], final, final_sm)
+
+    base = {(agent, "online"): reading("online") for agent in AGENTS}
+    # each condition at its boundary: as many failures, 98 % of the return, the same SM
+    assert (
+        d4_verdict({**base, **{(agent, "average"): reading("average", 1, 490.0, 0.01) for agent in AGENTS}}, True) == "adopt"
+    )
+    lower = {("gqn-adaptive", "average"): reading("average", 0, 489.9), ("decqn-9", "average"): reading("average")}
+    assert d4_verdict({**base, **lower}, True) == "reject"
+    rougher = {("gqn-adaptive", "average"): reading("average"), ("decqn-9", "average"): reading("average", final_sm=0.0101)}
+    assert d4_verdict({**base, **rougher}, True).startswith("not adopted")
+    more_failures = {("gqn-adaptive", "average"): reading("average", 2), ("decqn-9", "average"): reading("average")}
+    assert d4_verdict({**base, **more_failures}, True).startswith("not adopted")
