@@ -9,8 +9,9 @@
    cartpole-swingup (5-dim observations, 1x9 utilities) and humanoid-walk (67-dim, 21x9): ms per update against
    the FLOP-bound time, 5 forward-pass equivalents (online forward and backward on obs, online and target
    forward on next_obs) at the measured peak. Peak and update are measured alternately, --rounds times,
-   and the median ratio is reported: the machine's speed drifts. The same gradient step with ``acting_tau``
-   (the averaged acting network's Polyak step after it), alternating with the plain one, gives its overhead.
+   and the median ratio is reported: the machine's speed drifts. These steps run without an averaged acting
+   network (``acting_tau=None``); the same step with the default ``acting_tau`` (its Polyak step after the update),
+   alternating with them, gives its overhead.
 3. Acting at batch 1 (cartpole-swingup): the bare three matmuls and argmax, the lean path
    (GQNPolicy.act), GQN.predict (env action) and SB3's BasePolicy.predict on the same policy.
 4. The exported policy (sb3_gqn.export) at batch 1: TorchScript and ONNX Runtime, next to predict.
@@ -79,9 +80,9 @@ def forward_flops(network: nn.Module, batch_size: int) -> int:
 
 
 def update_cost(env_id: str, rounds: int, updates: int, device: str = "cpu") -> dict[str, float]:
-    """A gradient step's time against its FLOP bound, and with ``acting_tau`` (the averaged acting network's Polyak
-    step after it), the two alternating in every round."""
-    model = GQN("MlpPolicy", make_env(env_id, action_penalty=0.1), seed=0, device=device)
+    """A gradient step's time against its FLOP bound (``acting_tau=None``: no averaged acting network), and with the
+    default ``acting_tau`` (its Polyak step after every update), the two alternating in every round."""
+    model = GQN("MlpPolicy", make_env(env_id, action_penalty=0.1), acting_tau=None, seed=0, device=device)
     averaged = GQN("MlpPolicy", make_env(env_id, action_penalty=0.1), acting_tau=0.001, seed=0, device=device)
     for trained in (model, averaged):
         trained.learn(trained.learning_starts + 500)

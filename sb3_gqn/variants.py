@@ -21,6 +21,7 @@ BEFORE_GROWTH_FIXES: dict[str, Any] = {
     "growth_patience": None,
     "growth_eval_freq": 5_000,
     "exploration": "per_dimension",
+    "acting_tau": None,
 }
 #: Shipped entries as they were before issue 11 changed them; the ablation (``gqn-before*``) runs on these, so
 #: that its seeds stay comparable with the ones recorded before the change
@@ -66,11 +67,15 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     # two critics (DecQN's use_double_q) on the entry's own torso and update ratio (POLICY_KWARGS_ADDED)
     "gqn-adaptive+twin": ("gqn", {"growth": "adaptive"}),
     "decqn-9+twin": ("decqn", {"bins": 9}),
-    # acting on a Polyak-averaged copy of the online network (acting_tau, rule D3), training unchanged
+    # acting on a Polyak-averaged copy of the online network (acting_tau, rule D3; 0.001 is the default since rule
+    # D4, so +avg0.001 trains and acts as the plain name), training unchanged; +online acts on the online network
+    # (acting_tau=None), as every run recorded before D4 did
     "gqn-adaptive+avg0.005": ("gqn", {"growth": "adaptive", "acting_tau": 0.005}),
     "gqn-adaptive+avg0.001": ("gqn", {"growth": "adaptive", "acting_tau": 0.001}),
     "decqn-9+avg0.005": ("decqn", {"bins": 9, "acting_tau": 0.005}),
     "decqn-9+avg0.001": ("decqn", {"bins": 9, "acting_tau": 0.001}),
+    "gqn-adaptive+online": ("gqn", {"growth": "adaptive", "acting_tau": None}),
+    "decqn-9+online": ("decqn", {"bins": 9, "acting_tau": None}),
 }
 #: Policy keyword arguments a variant adds to its entry's ``policy_kwargs`` (keeping the entry's torso), as the
 #: source of a ``dict(...)`` call like the entries' own

@@ -108,12 +108,20 @@ def test_learn_save_and_load_keep_the_averaged_network(tmp_path, algorithm):
     loaded.learn(50, reset_num_timesteps=False)  # a resumed run keeps averaging
 
 
-def test_without_acting_tau_the_policy_keeps_no_copy():
-    model = GQN("MlpPolicy", "Pendulum-v1", **SMALL)
+def test_acting_tau_none_keeps_no_copy():
+    model = GQN("MlpPolicy", "Pendulum-v1", acting_tau=None, **SMALL)
     assert len(model.policy.acting_q_nets) == 0
     assert not any(key.startswith("acting_q_nets") for key in model.policy.state_dict())
-    assert "averaged_acting" not in model.policy_kwargs  # a default model saves the policy_kwargs it always did
+    assert "averaged_acting" not in model.policy_kwargs  # such a model saves the policy_kwargs it did before D4
     assert model.policy.acting_networks() == [model.q_net]
+
+
+@pytest.mark.parametrize("algorithm", [GQN, DecQN])
+def test_the_default_acts_on_the_average_at_0_001(algorithm):
+    model = algorithm("MlpPolicy", "Pendulum-v1", **SMALL)  # rule D4 made 0.001 the default of both agents
+    assert model.acting_tau == 0.001
+    assert model.policy.averaged_acting and len(model.policy.acting_q_nets) == 1
+    assert model.policy.acting_networks() == [model.policy.acting_q_nets[0]]
 
 
 @pytest.mark.parametrize("acting_tau", [0.0, 1.5, -0.1, float("nan"), "0.1"])
@@ -124,9 +132,10 @@ def test_acting_tau_outside_0_1_is_refused(acting_tau):
 
 def test_acting_tau_can_be_set_or_unset_when_a_model_is_loaded(tmp_path):
     kwargs = {**SMALL, "policy_kwargs": dict(net_arch=[16], n_critics=2)}
-    plain = GQN("MlpPolicy", "Pendulum-v1", train_freq=1, **kwargs)
+    plain = GQN("MlpPolicy", "Pendulum-v1", train_freq=1, acting_tau=None, **kwargs)
     plain.learn(100)
     plain.save(tmp_path / "plain.zip")
+    assert GQN.load(tmp_path / "plain.zip").acting_tau is None  # a model keeps the acting_tau it was saved with
     # saved without the averaged networks: they start as copies of the loaded online networks, critic by critic
     averaged = GQN.load(tmp_path / "plain.zip", acting_tau=0.01)
     assert averaged.acting_tau == 0.01

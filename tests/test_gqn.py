@@ -405,7 +405,8 @@ def test_two_critics_act_on_their_maximum_learn_both_grow_both_and_round_trip(tm
     """policy_kwargs n_critics=2 (DecQN's use_double_q): both critics train, greedy actions maximize the element-wise
     maximum of their utilities, growth warm-starts both, and save/load keeps both and the optimizer over both."""
     options = {**SMALL, "policy_kwargs": dict(net_arch=[32, 32], n_critics=2)}
-    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, **options)
+    # acting on the online critics, which this test edits (the averaged copies: tests/test_averaged_acting.py)
+    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, acting_tau=None, **options)
     policy = model.policy
     assert len(policy.critics) == 2 and policy.critics[0] == (model.q_net, model.q_net_target)
     optimized = {id(parameter) for group in policy.optimizer.param_groups for parameter in group["params"]}

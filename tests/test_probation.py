@@ -94,7 +94,8 @@ def test_growth_probation_must_be_a_positive_int():
 
 
 def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_level():
-    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth_probation=2, **SMALL)
+    # predict acting on the online network, which this test edits (acting_tau=None)
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth_probation=2, acting_tau=None, **SMALL)
     model.grow(1, probation=True)  # 2 -> 3 bins opened, the deployed level stays at 2
     assert (model.active_bins, model.deployed_bins) == (3, 2)
     assert model.policy.active_bins_mask.tolist() == active_bin_mask(9, 2).tolist()
