@@ -34,9 +34,10 @@ os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoC
 
 import gymnasium as gym
 from filelock import FileLock
+from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
 
-from sb3_gqn.metrics import rollout_figures
+from sb3_gqn.metrics import SmoothnessFigures, rollout_figures
 from sb3_gqn.processes import run_in_processes
 from sb3_gqn.variants import (
     ABLATION,
@@ -74,6 +75,31 @@ COLUMNS = [
 ]
 
 
+def evaluation_row(spec: RunSpec, model: BaseAlgorithm, figures: SmoothnessFigures, wall_time: float | str) -> dict[str, Any]:
+    """One ``results.csv`` row (``COLUMNS``): run ``spec``'s evaluation of ``model`` at its current step, with the
+    greedy episodes' ``figures`` and ``wall_time`` training seconds so far."""
+    return {
+        "algo": spec.algo,
+        "env": spec.env,
+        "penalty": spec.penalty,
+        "seed": spec.seed,
+        "step": model.num_timesteps,
+        "return": figures.return_,
+        "task_return": figures.task_return,
+        "action_penalty": figures.penalty,
+        "action_magnitude": figures.action_magnitude,
+        "action_change": figures.action_change,
+        "smoothness": figures.smoothness,
+        "smoothness_freq": figures.freq,
+        "episode_length": figures.episode_length,
+        "active_bins": getattr(model, "active_bins", ""),
+        "wall_time": wall_time,
+        "growth_events": " ".join(f"{step}:{bins}" for step, bins in getattr(model, "growth_events", [])),
+        "deployed_bins": getattr(model, "deployed_bins", ""),
+        "deployments": " ".join(f"{step}:{bins}" for step, bins in getattr(model, "deployments", [])),
+    }
+
+
 class BenchmarkCallback(BaseCallback):
     """Evaluates greedily every ``eval_freq`` steps and at the end; appends a row per evaluation to ``curve.csv``.
 
@@ -101,26 +127,7 @@ class BenchmarkCallback(BaseCallback):
     def evaluate(self) -> None:
         self.train_seconds += time.perf_counter() - self.started
         figures = rollout_figures(self.model, self.eval_env, self.n_episodes, seed=10_000 + self.spec.seed)
-        row = {
-            "algo": self.spec.algo,
-            "env": self.spec.env,
-            "penalty": self.spec.penalty,
-            "seed": self.spec.seed,
-            "step": self.num_timesteps,
-            "return": figures.return_,
-            "task_return": figures.task_return,
-            "action_penalty": figures.penalty,
-            "action_magnitude": figures.action_magnitude,
-            "action_change": figures.action_change,
-            "smoothness": figures.smoothness,
-            "smoothness_freq": figures.freq,
-            "episode_length": figures.episode_length,
-            "active_bins": getattr(self.model, "active_bins", ""),
-            "wall_time": round(self.train_seconds, 2),
-            "growth_events": " ".join(f"{step}:{bins}" for step, bins in getattr(self.model, "growth_events", [])),
-            "deployed_bins": getattr(self.model, "deployed_bins", ""),
-            "deployments": " ".join(f"{step}:{bins}" for step, bins in getattr(self.model, "deployments", [])),
-        }
+        row = evaluation_row(self.spec, self.model, figures, round(self.train_seconds, 2))
         with open(self.run_dir / "curve.csv", "a", newline="") as handle:
             writer = csv.DictWriter(handle, fieldnames=COLUMNS)
             if handle.tell() == 0:

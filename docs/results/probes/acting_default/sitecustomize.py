@@ -10,6 +10,8 @@ evaluates the same model once more with the same arguments (the same episodes on
 only), and appends a row in the runner's ``results.csv`` format to ``PROBE_ONLINE_DIR/<algo>__<env>__seed<seed>.csv``
 with ``algo`` the agent's plain name (``gqn-<growth>`` or ``decqn-<bins>``): what the runner would have written for
 the same run without ``acting_tau``. The runner's training seconds exclude it (it runs inside the evaluation).
+Since rule D4 every plain run acts on an average too (``acting_tau=0.001`` is the default), and the file names only
+the agent and seed: give each suite that runs two variants of one agent on one seed its own ``PROBE_ONLINE_DIR``.
 
 Nothing here draws a random number (greedy ``predict``, seeded resets), so the run's own rows are those of a run
 without the probe. Without ``PROBE_ONLINE_DIR`` it does nothing. Runs (from the repository root)::
@@ -32,28 +34,6 @@ if os.environ.get("PROBE_ONLINE_DIR"):
     from sb3_gqn.gqn import GQN
 
     OUT = Path(os.environ["PROBE_ONLINE_DIR"])
-    # the runner's results.csv columns (sb3_gqn.benchmark.COLUMNS, not imported here: that would import the runner
-    # before ``python -m`` runs it)
-    COLUMNS = [
-        "algo",
-        "env",
-        "penalty",
-        "seed",
-        "step",
-        "return",
-        "task_return",
-        "action_penalty",
-        "action_magnitude",
-        "action_change",
-        "smoothness",
-        "smoothness_freq",
-        "episode_length",
-        "active_bins",
-        "wall_time",
-        "growth_events",
-        "deployed_bins",
-        "deployments",
-    ]
     original_rollout_figures = metrics.rollout_figures
     started: set[Path] = set()  # files this process has begun: a run that starts again rewrites its file
 
@@ -76,27 +56,14 @@ if os.environ.get("PROBE_ONLINE_DIR"):
             online = original_rollout_figures(model, env, n_episodes, deterministic, **kwargs)
         finally:
             model.policy.averaged_acting = True
+        # the runner's own row and columns, imported here: importing the runner when this file loads would put it in
+        # sys.modules before ``python -m sb3_gqn.benchmark`` runs it
+        from sb3_gqn.benchmark import COLUMNS, evaluation_row
+        from sb3_gqn.variants import RunSpec
+
         env_id = env.unwrapped.spec.id if env.unwrapped.spec is not None else "env"
-        row = {
-            "algo": agent_name(model),
-            "env": env_id,
-            "penalty": penalty_of(env),
-            "seed": model.seed,
-            "step": model.num_timesteps,
-            "return": online.return_,
-            "task_return": online.task_return,
-            "action_penalty": online.penalty,
-            "action_magnitude": online.action_magnitude,
-            "action_change": online.action_change,
-            "smoothness": online.smoothness,
-            "smoothness_freq": online.freq,
-            "episode_length": online.episode_length,
-            "active_bins": model.active_bins,
-            "wall_time": "",
-            "growth_events": " ".join(f"{step}:{bins}" for step, bins in model.growth_events),
-            "deployed_bins": model.deployed_bins,
-            "deployments": " ".join(f"{step}:{bins}" for step, bins in model.deployments),
-        }
+        spec = RunSpec(agent_name(model), env_id, penalty_of(env), model.seed, steps=0)  # steps: not in the row
+        row = evaluation_row(spec, model, online, wall_time="")
         path = OUT / f"{row['algo']}__{env_id.replace('/', '-')}__seed{model.seed}.csv"
         OUT.mkdir(parents=True, exist_ok=True)
         with path.open("a" if path in started else "w", newline="") as handle:
