@@ -765,3 +765,89 @@ def test_acting_default_reads_both_networks_on_the_same_evaluations(tmp_path: Pa
     assert d4_verdict({**base, **rougher}, True).startswith("not adopted")
     more_failures = {("gqn-adaptive", "average"): reading("average", 2), ("decqn-9", "average"): reading("average")}
     assert d4_verdict({**base, **more_failures}, True).startswith("not adopted")
+
+
+def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on_one_network(tmp_path: Path):
+    from acting_default import AGENTS, TASKS
+    from bar_averaged import (
+        SEEDS_FOR_OUTCOME,
+        complete,
+        determinism_mismatches,
+        probe_rows,
+        sm_item,
+        walker_item,
+        with_network,
+    )
+
+    walker = "dm_control/walker-walk-v0"
+
+    def rows(algo: str, seed: int, returns: list[float], sms: list[float], bins: list[int]) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "algo": algo,
+                "env": walker,
+                "penalty": 0.1,
+                "seed": seed,
+                "step": [10_000, 20_000],
+                "return": returns,
+                "smoothness": sms,
+                "active_bins": bins,
+                "growth_events": "",
+            }
+        )
+
+    folder = tmp_path / "d5" / "walker"
+    (folder / "online").mkdir(parents=True)
+    pd.concat(
+        [
+            rows("gqn-adaptive+avg0.001", 2, [100.0, 700.0], [0.02, 0.010], [3, 9]),
+            rows("decqn-9+avg0.001", 2, [50.0, 500.0], [0.02, 0.012], [9, 9]),
+        ]
+    ).to_csv(folder / "results.csv", index=False)
+    rows("gqn-adaptive", 2, [100.0, 600.0], [0.02, 0.014], [3, 9]).to_csv(folder / "online" / "a.csv", index=False)
+    rows("decqn-9", 2, [50.0, 400.0], [0.02, 0.016], [9, 9]).to_csv(folder / "online" / "b.csv", index=False)
+    # a folder without finished runs (a task not started yet) is skipped
+    (tmp_path / "d4").mkdir()
+    probe = probe_rows([tmp_path / "d4", tmp_path / "d5"])
+    assert len(probe) == 8
+
+    tables = pd.concat(
+        [
+            # gqn-adaptive seed 2: equal up to 1e-7 at 10k, another active bin count at 20k
+            rows("gqn-adaptive", 2, [100.0 + 1e-7, 600.0], [0.02, 0.014], [3, 5]),
+            # decqn-9 seed 2: the same run
+            rows("decqn-9", 2, [50.0, 400.0], [0.02, 0.016], [9, 9]),
+            # seeds the probe did not read, and SAC
+            rows("gqn-adaptive", 3, [0.0, 300.0], [0.02, 0.020], [3, 9]),
+            rows("sac", 0, [0.0, 200.0], [0.0, 0.001], [0, 0]),
+            rows("sac", 1, [0.0, 400.0], [0.0, 0.001], [0, 0]),
+        ],
+        ignore_index=True,
+    )
+    compared, mismatches = determinism_mismatches(probe, tables)
+    assert compared == 2
+    assert mismatches == [
+        "walker-walk-v0 gqn-adaptive seed 2: 1 of 2 evaluations differ (probe vs table), first at 20000: active_bins 9 vs 5"
+    ]
+    tables.loc[(tables["algo"] == "decqn-9") & (tables["step"] == 20_000), "return"] = 401.0
+    assert determinism_mismatches(probe, tables)[1][0].endswith("first at 20000: return 400 vs 401")
+
+    average, online = with_network(tables, probe, "average"), with_network(tables, probe, "online")
+    # the agents' unread seed 3 is left out, SAC kept; each network's rows are its own
+    assert sorted(average.groupby("algo")["seed"].agg(lambda s: sorted(set(s))).items()) == [
+        ("decqn-9", [2]),
+        ("gqn-adaptive", [2]),
+        ("sac", [0, 1]),
+    ]
+    ours, theirs, difference, _, runs = sm_item(average, walker)
+    assert (ours, theirs, runs) == (0.010, 0.012, 1) and difference == pytest.approx(-0.002)
+    assert sm_item(online, walker)[:2] == (0.014, 0.016)
+    # gqn-adaptive 700 (average) / 600 (online) against SAC's mean final return (200 + 400) / 2 = 300
+    assert walker_item(average)[:3] == (700.0, 300.0, 400.0) and walker_item(online)[:3] == (600.0, 300.0, 300.0)
+    assert walker_item(average)[4:] == (1, 2)
+
+    every_run = pd.DataFrame(
+        [(agent, task, seed, "average") for agent in AGENTS for task in TASKS for seed in SEEDS_FOR_OUTCOME],
+        columns=["algo", "env", "seed", "network"],
+    )
+    assert complete(every_run) and not complete(every_run.iloc[:-1]) and not complete(probe)
