@@ -26,9 +26,10 @@ RADAR_METRICS = {
     "smoothness": "SM",
 }
 RADAR_CAPTION = (
-    "R: task return (larger is better); P: action penalty c·Σa², |a|: mean action magnitude, |Δa|: mean action change "
+    "R: task return, 1 + (R - R_ref) / |R_ref| (the ratio when returns are positive; larger is better); "
+    "P: action penalty c·Σa², |a|: mean action magnitude, |Δa|: mean action change "
     "between steps, SM: smoothness (spectral, higher frequencies weigh more): smaller is smoother. "
-    "Each axis is the ratio to the reference agent."
+    "The other axes are ratios to the reference agent."
 )
 #: radar ratios above this are drawn at it, with their value written beside the point, so that one agent's
 #: outlier (e.g. decqn-2's action penalty, ~10x the reference's) does not squeeze every other line into the centre
@@ -282,6 +283,19 @@ def clipped_radii(ratios: np.ndarray, clip: float = RADAR_CLIP) -> tuple[np.ndar
     return np.where(clipped, clip, ratios), clipped
 
 
+def return_radius(returns: np.ndarray, reference: float) -> np.ndarray:
+    """The radar's R for task ``returns`` against the reference agent's: ``1 + (R - R_ref) / |R_ref|``, at least 0.
+
+    With a positive reference this is the ratio ``R / R_ref`` (800 against 400: 2.0). With a negative one (Pendulum)
+    a plain ratio would grow as the return gets worse; this keeps larger better: -200 against -100 is 0 (twice the
+    cost), -50 against -100 is 1.5, 0 against -100 is 2. A zero reference has no scale: NaN.
+    """
+    returns = np.asarray(returns, dtype=np.float64)
+    if reference == 0.0 or not np.isfinite(reference):
+        return np.full_like(returns, np.nan)
+    return np.maximum(1.0 + (returns - reference) / abs(reference), 0.0)
+
+
 def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
     """Figure 4 per env: R, P, |a|, |Δa|, SM of the final policies relative to the reference agent."""
     paths = []
@@ -295,7 +309,11 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
         any_clipped = False
         for index, ((algo, penalty), values) in enumerate(means.iterrows()):
-            relative = (values / base).abs().fillna(0.0).to_numpy()
+            relative = (values / base).abs()
+            relative["task_return"] = return_radius(
+                np.array([values["task_return"]]), float(means.loc[reference, "task_return"])
+            )[0]
+            relative = relative.fillna(0.0).to_numpy()
             radii, clipped = clipped_radii(relative)
             closed = np.append(radii, radii[0])
             # markers and dash patterns tell apart lines that coincide (e.g. two agents that are both bang-bang)

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 import sb3_gqn.plots as plots
 from sb3_gqn import GQN
@@ -15,6 +16,7 @@ from sb3_gqn.plots import (
     mean_curve,
     normalized_final_scores,
     q_value_picture,
+    return_radius,
     save_q_snapshot,
     smoothness_radar,
 )
@@ -59,6 +61,27 @@ def test_radar_clips_outlying_ratios_and_writes_their_value(tmp_path, monkeypatc
     assert [text.get_text() for text in axis.texts] == ["10.2x"]  # P; |a| is 3.3x, drawn as it is
     assert max(max(line.get_ydata()) for line in axis.get_lines()) == RADAR_CLIP
     assert "drawn at 4" in " ".join(text.get_text() for text in figures[0].texts)
+
+
+def test_radar_return_axis_keeps_larger_better_when_returns_are_negative(tmp_path, monkeypatch):
+    # positive reference: the ratio (800 / 400 = 2, 200 / 400 = 0.5); a negative return draws at 0
+    np.testing.assert_allclose(return_radius(np.array([800.0, 200.0, -50.0]), 400.0), [2.0, 0.5, 0.0])
+    # negative reference (Pendulum): -200 costs twice -100 (0), -50 half (1.5), 0 none (2), -300 is drawn at 0
+    np.testing.assert_allclose(return_radius(np.array([-200.0, -50.0, 0.0, -300.0]), -100.0), [0.0, 1.5, 2.0, 0.0])
+    assert np.isnan(return_radius(np.array([5.0]), 0.0)).all()
+    final = {"task_return": -89.0, "action_penalty": 1.0, "action_magnitude": 0.3, "action_change": 0.1, "smoothness": 0.01}
+    worse = {**final, "task_return": -166.0}  # the session-9 short suite's decqn-9: drawn at 1.87 before this axis
+    rows = [
+        {"algo": algo, "env": "Pendulum-v1", "penalty": 0.1, "seed": 0, "step": 100, **values}
+        for algo, values in (("gqn-linear", final), ("decqn-9", worse))
+    ]
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    smoothness_radar(pd.DataFrame(rows), tmp_path)
+    [axis] = figures[0].axes
+    by_label = {line.get_label(): line.get_ydata() for line in axis.get_lines()}
+    assert by_label["gqn-linear c=0.1"][0] == 1.0  # the reference is 1 on every axis
+    assert by_label["decqn-9 c=0.1"][0] == pytest.approx(1.0 + (-166.0 + 89.0) / 89.0)  # 0.13: worse, smaller
 
 
 def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
