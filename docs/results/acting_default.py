@@ -111,6 +111,20 @@ def read_network(table: pd.DataFrame, agent: str, network: str, start: int) -> N
     )
 
 
+def final_lines(table: pd.DataFrame) -> list[str]:
+    """One line per run of ``table``: its final return and SM on the online network, then on the average."""
+    finals = table.sort_values("step").groupby(["env", "algo", "seed", "network"]).last().reset_index()
+    lines = []
+    for (env, agent, seed), run in finals.groupby(["env", "algo", "seed"]):
+        by_network = run.set_index("network")
+        lines.append(
+            f"{str(env).split('/')[-1]:18s} {agent:13s} seed {seed}: return "
+            f"{by_network.loc['online', 'return']:.1f} -> {by_network.loc['average', 'return']:.1f}, SM "
+            f"{by_network.loc['online', 'smoothness']:.4f} -> {by_network.loc['average', 'smoothness']:.4f}"
+        )
+    return lines
+
+
 def complete(table: pd.DataFrame) -> bool:
     """Whether both agents finished seeds 0 and 1 on all three tasks (D4 takes its verdict only then)."""
     done = set(map(tuple, table[table["network"] == "average"][["algo", "env", "seed"]].drop_duplicates().to_numpy()))
@@ -156,14 +170,8 @@ def main(argv: list[str] | None = None) -> int:
             for failure in reading.growth_failed + reading.late_failed:
                 print(f"    {failure}")
     print("final return / SM per task and seed (online -> average):")
-    finals = table.sort_values("step").groupby(["env", "algo", "seed", "network"]).last().reset_index()
-    for (env, agent, seed), run in finals.groupby(["env", "algo", "seed"]):
-        by_network = run.set_index("network")
-        print(
-            f"    {str(env).split('/')[-1]:18s} {agent:13s} seed {seed}: return "
-            f"{by_network.loc['online', 'return']:.1f} -> {by_network.loc['average', 'return']:.1f}, SM "
-            f"{by_network.loc['online', 'smoothness']:.4f} -> {by_network.loc['average', 'smoothness']:.4f}"
-        )
+    for line in final_lines(table):
+        print(f"    {line}")
     print(f"D4: {verdict(readings, complete(table))}")
     return 0
 

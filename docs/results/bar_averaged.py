@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 import pandas as pd
-from acting_default import AGENTS, TASKS, paired_table, read_network
+from acting_default import AGENTS, TASKS, final_lines, paired_table, read_network
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
 from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores
@@ -133,12 +133,18 @@ def main(argv: list[str] | None = None) -> int:
     seeds = probe[probe["network"] == "average"].groupby(["env", "algo"])["seed"].agg(lambda s: sorted(set(s)))
     for (env, agent), read in seeds.items():
         print(f"runs read: {str(env).split('/')[-1]:18s} {agent:13s} seeds {read}")
+    print("final return / SM per run (online -> average):")
+    for line in final_lines(probe):
+        print(f"    {line}")
     for network in ["online", "average"]:
         table = with_network(tables, probe, network)
         growth = read_network(probe, "gqn-adaptive", network, start=30_000)
         print(f"--- {network} network")
-        print(f"(1) gqn-adaptive growth events failed {len(growth.growth_failed)} of {growth.growth_pairs}")
-        for failure in growth.growth_failed:
+        print(
+            f"(1) gqn-adaptive growth events failed {len(growth.growth_failed)} of {growth.growth_pairs}; pairs after "
+            f"the last growth from 30k (not an item, reported) {len(growth.late_failed)} of {growth.late_pairs}"
+        )
+        for failure in growth.growth_failed + growth.late_failed:
             print(f"    {failure}")
         estimates, difference, interval = iqm_item(table)
         print(
