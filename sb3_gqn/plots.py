@@ -310,9 +310,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         any_clipped = False
         for index, ((algo, penalty), values) in enumerate(means.iterrows()):
             relative = (values / base).abs()
-            relative["task_return"] = return_radius(
-                np.array([values["task_return"]]), float(means.loc[reference, "task_return"])
-            )[0]
+            relative["task_return"] = return_radius(np.array([values["task_return"]]), float(base["task_return"]))[0]
             relative = relative.fillna(0.0).to_numpy()
             radii, clipped = clipped_radii(relative)
             closed = np.append(radii, radii[0])

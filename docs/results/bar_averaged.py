@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pandas as pd
 from acting_default import AGENTS, TASKS, final_lines, paired_table, read_network
+from acting_default import complete as complete_on
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
 from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores
@@ -93,30 +94,33 @@ def iqm_item(table: pd.DataFrame) -> tuple[dict[str, float], float, tuple[float,
     return {algo: float(value[0]) for algo, value in estimates.items()}, difference, interval
 
 
+def final_means(
+    table: pd.DataFrame, env: str, column: str, first: str, second: str
+) -> tuple[float, float, float, tuple[float, float], int, int]:
+    """Mean final ``column`` on ``env`` of agent ``first`` and of ``second``, the difference with its 95 % interval,
+    and the runs of each."""
+    final = final_rows(table[table["env"] == env])
+    values_first = final[final["algo"] == first][column].to_numpy()
+    values_second = final[final["algo"] == second][column].to_numpy()
+    difference, interval = difference_interval(mean_difference, values_first, values_second, 2000)
+    return float(values_first.mean()), float(values_second.mean()), difference, interval, len(values_first), len(values_second)
+
+
 def sm_item(table: pd.DataFrame, env: str) -> tuple[float, float, float, tuple[float, float], int]:
     """Mean final SM of gqn-adaptive and of decqn-9 on ``env``, their difference with its 95 % interval, and the
     number of runs a side."""
-    final = final_rows(table[table["env"] == env])
-    first = final[final["algo"] == "gqn-adaptive"]["smoothness"].to_numpy()
-    second = final[final["algo"] == "decqn-9"]["smoothness"].to_numpy()
-    difference, interval = difference_interval(mean_difference, first, second, 2000)
-    return float(first.mean()), float(second.mean()), difference, interval, len(first)
+    return final_means(table, env, "smoothness", "gqn-adaptive", "decqn-9")[:5]
 
 
 def walker_item(table: pd.DataFrame) -> tuple[float, float, float, tuple[float, float], int, int]:
     """Mean final return on walker-walk of gqn-adaptive and of SAC, the difference with its 95 % interval, and the
     runs of each."""
-    final = final_rows(table[table["env"] == WALKER])
-    first = final[final["algo"] == "gqn-adaptive"]["return"].to_numpy()
-    second = final[final["algo"] == "sac"]["return"].to_numpy()
-    difference, interval = difference_interval(mean_difference, first, second, 2000)
-    return float(first.mean()), float(second.mean()), difference, interval, len(first), len(second)
+    return final_means(table, WALKER, "return", "gqn-adaptive", "sac")
 
 
 def complete(probe: pd.DataFrame) -> bool:
     """Whether both agents finished seeds 0-11 on all three tasks (D5's outcome waits for it)."""
-    done = set(map(tuple, probe[probe["network"] == "average"][["algo", "env", "seed"]].drop_duplicates().to_numpy()))
-    return all((agent, task, seed) in done for agent in AGENTS for task in TASKS for seed in SEEDS_FOR_OUTCOME)
+    return complete_on(probe, SEEDS_FOR_OUTCOME)
 
 
 def main(argv: list[str] | None = None) -> int:
