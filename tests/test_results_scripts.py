@@ -839,8 +839,8 @@ def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on
         ("gqn-adaptive", [2]),
         ("sac", [0, 1]),
     ]
-    ours, theirs, difference, _, runs = sm_item(average, walker)
-    assert (ours, theirs, runs) == (0.010, 0.012, 1) and difference == pytest.approx(-0.002)
+    ours, theirs, difference, _, runs, other_runs = sm_item(average, walker)
+    assert (ours, theirs, runs, other_runs) == (0.010, 0.012, 1, 1) and difference == pytest.approx(-0.002)
     assert sm_item(online, walker)[:2] == (0.014, 0.016)
     # gqn-adaptive 700 (average) / 600 (online) against SAC's mean final return (200 + 400) / 2 = 300
     assert walker_item(average)[:3] == (700.0, 300.0, 400.0) and walker_item(online)[:3] == (600.0, 300.0, 300.0)
@@ -851,3 +851,54 @@ def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on
         columns=["algo", "env", "seed", "network"],
     )
     assert complete(every_run) and not complete(every_run.iloc[:-1]) and not complete(probe)
+
+
+def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row():
+    from acting_default import NetworkReading
+    from bar_averaged import Items, markdown_table, seed_ranges
+
+    cartpole, finger, walker = (f"dm_control/{task}-v0" for task in ["cartpole-swingup", "finger-spin", "walker-walk"])
+    probe = pd.DataFrame(
+        [(agent, cartpole, seed, "average") for agent in ["gqn-adaptive", "decqn-9"] for seed in [0, 1, 2, 4]]
+        + [(agent, walker, seed, "average") for agent in ["gqn-adaptive", "decqn-9"] for seed in [0, 1]]
+        # a seed only one agent finished (and an online row) is not read as finished
+        + [("gqn-adaptive", walker, 2, "average"), ("decqn-9", finger, 5, "online")],
+        columns=["algo", "env", "seed", "network"],
+    )
+    assert seed_ranges(probe) == "cartpole-swingup 0, 1, 2, 4; walker-walk 0-1"
+
+    def items(network: str, failed: list[str], walker_return: float) -> Items:
+        growth = NetworkReading("gqn-adaptive", network, 4, 7, failed, 9, [], 0.0, 0.0)
+        sm = {env: (0.012, 0.010, 0.002, (-0.001, 0.005), 4, 4 if env != finger else 3) for env in [cartpole, finger, walker]}
+        return Items(
+            network,
+            growth,
+            {"gqn-adaptive": 0.9, "decqn-9": 0.7},
+            0.2,
+            (0.1, 0.4),
+            sm,
+            (walker_return, 369.4, walker_return - 369.4, (200.0, 400.0), 4, 12),
+        )
+
+    table = markdown_table(
+        probe, items("online", ["walker-walk-v0 seed 0 -> 9 bins: 504 -> 307"], 695.2), items("average", [], 717.0)
+    )
+    assert table[0] == (
+        "| item (gqn-adaptive and decqn-9, seeds cartpole-swingup 0, 1, 2, 4; walker-walk 0-1) | online network "
+        "| average at 0.001 (the default) |"
+    )
+    assert table[2] == (
+        "| no collapse: growth events failed | 1 of 7 (walker-walk-v0 seed 0 -> 9 bins: 504 -> 307) | 0 of 7 |"
+    )
+    assert table[3].endswith("| 0 of 9 | 0 of 9 |")
+    assert table[4].endswith("| 0.90 vs 0.70 (+0.20 [+0.10, +0.40]) | 0.90 vs 0.70 (+0.20 [+0.10, +0.40]) |")
+    assert table[5] == (
+        "| SM cartpole-swingup (4 runs a side) | 0.0120 vs 0.0100 (+0.0020 [-0.0010, +0.0050]) "
+        "| 0.0120 vs 0.0100 (+0.0020 [-0.0010, +0.0050]) |"
+    )
+    assert table[6].startswith("| SM finger-spin (4 and 3 runs) |")
+    assert table[8] == (
+        "| walker-walk return, gqn-adaptive vs SAC (12 recorded runs) | 695 vs 369 (+326 [+200, +400]) "
+        "| 717 vs 369 (+348 [+200, +400]) |"
+    )
+    assert len(table) == 9

@@ -8,18 +8,20 @@ tables' rows of the same agent, task and seed (``readme_tables.shipped``). Then,
 gqn-adaptive's growth events that fail the collapse criterion; (2) the IQM of normalized final return over seeds 0-7
 (the tables' other agents and seeds keep their rows, so the normalization is the bar's); (3) the mean final SM per
 task, gqn-adaptive against decqn-9; (4) walker-walk's mean final return, gqn-adaptive against SAC's recorded runs.
+``--markdown`` prints the items as the results report's table (online and average side by side).
 
-    .venv/bin/python docs/results/bar_averaged.py
+    .venv/bin/python docs/results/bar_averaged.py [--markdown]
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from acting_default import AGENTS, TASKS, final_lines, paired_table, read_network
+from acting_default import AGENTS, TASKS, NetworkReading, final_lines, paired_table, read_network
 from acting_default import complete as complete_on
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
@@ -34,6 +36,8 @@ WALKER = "dm_control/walker-walk-v0"
 #: what the check compares at every evaluation, and how closely
 CHECKED = ["return", "smoothness", "active_bins"]
 TOLERANCE = 1e-6
+#: ``final_means``: mean of the first agent, of the second, the difference, its 95 % interval, the runs of each
+Means = tuple[float, float, float, tuple[float, float], int, int]
 
 
 def probe_rows(folders: list[Path]) -> pd.DataFrame:
@@ -94,9 +98,7 @@ def iqm_item(table: pd.DataFrame) -> tuple[dict[str, float], float, tuple[float,
     return {algo: float(value[0]) for algo, value in estimates.items()}, difference, interval
 
 
-def final_means(
-    table: pd.DataFrame, env: str, column: str, first: str, second: str
-) -> tuple[float, float, float, tuple[float, float], int, int]:
+def final_means(table: pd.DataFrame, env: str, column: str, first: str, second: str) -> Means:
     """Mean final ``column`` on ``env`` of agent ``first`` and of ``second``, the difference with its 95 % interval,
     and the runs of each."""
     final = final_rows(table[table["env"] == env])
@@ -106,13 +108,13 @@ def final_means(
     return float(values_first.mean()), float(values_second.mean()), difference, interval, len(values_first), len(values_second)
 
 
-def sm_item(table: pd.DataFrame, env: str) -> tuple[float, float, float, tuple[float, float], int]:
-    """Mean final SM of gqn-adaptive and of decqn-9 on ``env``, their difference with its 95 % interval, and the
-    number of runs a side."""
-    return final_means(table, env, "smoothness", "gqn-adaptive", "decqn-9")[:5]
+def sm_item(table: pd.DataFrame, env: str) -> Means:
+    """Mean final SM of gqn-adaptive and of decqn-9 on ``env``, their difference with its 95 % interval, and the runs
+    of each."""
+    return final_means(table, env, "smoothness", "gqn-adaptive", "decqn-9")
 
 
-def walker_item(table: pd.DataFrame) -> tuple[float, float, float, tuple[float, float], int, int]:
+def walker_item(table: pd.DataFrame) -> Means:
     """Mean final return on walker-walk of gqn-adaptive and of SAC, the difference with its 95 % interval, and the
     runs of each."""
     return final_means(table, WALKER, "return", "gqn-adaptive", "sac")
@@ -123,13 +125,150 @@ def complete(probe: pd.DataFrame) -> bool:
     return complete_on(probe, SEEDS_FOR_OUTCOME)
 
 
+@dataclass(frozen=True)
+class Items:
+    """The bar's items read on one network: (1) gqn-adaptive's growth events (and the late pairs, reported), (2) the
+    IQM per main agent with gqn-adaptive - decqn-9 and its interval, (3) ``final_means`` of SM per task, (4)
+    ``final_means`` of walker-walk's return against SAC."""
+
+    network: str
+    growth: NetworkReading
+    iqm: dict[str, float]
+    iqm_difference: float
+    iqm_interval: tuple[float, float]
+    sm: dict[str, Means]
+    walker: Means
+
+
+def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> Items:
+    """Items (1)-(4) on ``network``: the probe's runs of ``AGENTS`` in place of the tables' (``with_network``)."""
+    table = with_network(tables, probe, network)
+    estimates, difference, interval = iqm_item(table)
+    return Items(
+        network,
+        read_network(probe, "gqn-adaptive", network, start=30_000),
+        estimates,
+        difference,
+        interval,
+        {env: sm_item(table, env) for env in TASKS},
+        walker_item(table),
+    )
+
+
+def short(env: str) -> str:
+    """``dm_control/walker-walk-v0`` -> ``walker-walk``."""
+    return env.split("/")[-1].removesuffix("-v0")
+
+
+def text_lines(items: Items) -> list[str]:
+    """The items as the scorer's plain-text report."""
+    growth = items.growth
+    lines = [
+        f"--- {items.network} network",
+        f"(1) gqn-adaptive growth events failed {len(growth.growth_failed)} of {growth.growth_pairs}; pairs after "
+        f"the last growth from 30k (not an item, reported) {len(growth.late_failed)} of {growth.late_pairs}",
+        *(f"    {failure}" for failure in growth.growth_failed + growth.late_failed),
+        f"(2) IQM (lowest {IQM_RUNS} seeds read): "
+        + ", ".join(f"{algo} {value:.2f}" for algo, value in sorted(items.iqm.items()))
+        + f"; gqn-adaptive - decqn-9 {items.iqm_difference:+.2f} "
+        f"[{items.iqm_interval[0]:+.2f}, {items.iqm_interval[1]:+.2f}]",
+    ]
+    for env, (ours, theirs, difference, interval, runs, _) in items.sm.items():
+        lines.append(
+            f"(3) SM {env.split('/')[-1]:18s} ({runs} runs): gqn-adaptive {ours:.4f} vs decqn-9 {theirs:.4f} "
+            f"({difference:+.4f} [{interval[0]:+.4f}, {interval[1]:+.4f}])"
+        )
+    ours, sac, difference, interval, runs, sac_runs = items.walker
+    lines.append(
+        f"(4) walker-walk return: gqn-adaptive {ours:.0f} ({runs} runs) vs SAC {sac:.0f} ({sac_runs} runs), "
+        f"{difference:+.0f} [{interval[0]:+.0f}, {interval[1]:+.0f}]"
+    )
+    return lines
+
+
+def seed_ranges(probe: pd.DataFrame) -> str:
+    """The seeds both agents finished per task, e.g. ``cartpole-swingup 0-4, finger-spin 0-3`` (gaps listed)."""
+    parts = []
+    for env in TASKS:
+        rows = probe[(probe["env"] == env) & (probe["network"] == "average")]
+        per_agent = [set(rows[rows["algo"] == agent]["seed"]) for agent in AGENTS]
+        seeds = sorted(set.intersection(*per_agent))
+        if not seeds:
+            continue
+        contiguous = seeds == list(range(seeds[0], seeds[-1] + 1))
+        described = f"{seeds[0]}-{seeds[-1]}" if contiguous and len(seeds) > 1 else ", ".join(map(str, seeds))
+        parts.append(f"{short(env)} {described}")
+    return "; ".join(parts)
+
+
+def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[str]:
+    """The results report's D5 table: one row per item, the online reading beside the average's."""
+
+    def failures(count: int, pairs: int, listed: list[str]) -> str:
+        return f"{count} of {pairs}" + (f" ({'; '.join(listed)})" if listed else "")
+
+    def iqm(items: Items) -> str:
+        low, high = items.iqm_interval
+        return (
+            f"{items.iqm['gqn-adaptive']:.2f} vs {items.iqm['decqn-9']:.2f} "
+            f"({items.iqm_difference:+.2f} [{low:+.2f}, {high:+.2f}])"
+        )
+
+    def means(values: Means, digits: int) -> str:
+        ours, theirs, difference, (low, high), _, _ = values
+        return f"{ours:.{digits}f} vs {theirs:.{digits}f} ({difference:+.{digits}f} [{low:+.{digits}f}, {high:+.{digits}f}])"
+
+    rows = [
+        (
+            "no collapse: growth events failed",
+            *(
+                failures(len(items.growth.growth_failed), items.growth.growth_pairs, items.growth.growth_failed)
+                for items in (online, average)
+            ),
+        ),
+        (
+            "pairs after the last growth from 30k failing the criterion (reported, not an item)",
+            *(
+                failures(len(items.growth.late_failed), items.growth.late_pairs, items.growth.late_failed)
+                for items in (online, average)
+            ),
+        ),
+        (
+            "IQM of normalized final return, gqn-adaptive vs decqn-9 (decqn-2, gqn-linear: the tables')",
+            iqm(online),
+            iqm(average),
+        ),
+    ]
+    for env in TASKS:
+        runs, other_runs = online.sm[env][4:]
+        side = f"{runs} runs a side" if runs == other_runs else f"{runs} and {other_runs} runs"
+        rows.append((f"SM {short(env)} ({side})", means(online.sm[env], 4), means(average.sm[env], 4)))
+    rows.append(
+        (
+            f"walker-walk return, gqn-adaptive vs SAC ({online.walker[5]} recorded runs)",
+            means(online.walker, 0),
+            means(average.walker, 0),
+        )
+    )
+    return [
+        f"| item (gqn-adaptive and decqn-9, seeds {seed_ranges(probe)}) | online network | average at 0.001 (the default) |",
+        "| --- | --- | --- |",
+        *(f"| {item} | {on_online} | {on_average} |" for item, on_online, on_average in rows),
+    ]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folders", type=Path, nargs="+", default=FOLDERS, help="probe folders, one subfolder per task")
+    parser.add_argument("--markdown", action="store_true", help="print the items as the results report's table")
     args = parser.parse_args(argv)
     probe = probe_rows(args.folders)
     tables = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
     tables = tables[tables["algo"].isin([*MAIN_ALGOS, "sac"])]
+    online, average = (read_items(tables, probe, network) for network in ["online", "average"])
+    if args.markdown:
+        print("\n".join(markdown_table(probe, online, average)))
+        return 0
     compared, mismatches = determinism_mismatches(probe, tables)
     print(f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ")
     for line in mismatches:
@@ -140,33 +279,8 @@ def main(argv: list[str] | None = None) -> int:
     print("final return / SM per run (online -> average):")
     for line in final_lines(probe):
         print(f"    {line}")
-    for network in ["online", "average"]:
-        table = with_network(tables, probe, network)
-        growth = read_network(probe, "gqn-adaptive", network, start=30_000)
-        print(f"--- {network} network")
-        print(
-            f"(1) gqn-adaptive growth events failed {len(growth.growth_failed)} of {growth.growth_pairs}; pairs after "
-            f"the last growth from 30k (not an item, reported) {len(growth.late_failed)} of {growth.late_pairs}"
-        )
-        for failure in growth.growth_failed + growth.late_failed:
-            print(f"    {failure}")
-        estimates, difference, interval = iqm_item(table)
-        print(
-            f"(2) IQM (lowest {IQM_RUNS} seeds read): "
-            + ", ".join(f"{algo} {value:.2f}" for algo, value in sorted(estimates.items()))
-            + f"; gqn-adaptive - decqn-9 {difference:+.2f} [{interval[0]:+.2f}, {interval[1]:+.2f}]"
-        )
-        for env in TASKS:
-            ours, theirs, sm_difference, sm_interval, runs = sm_item(table, env)
-            print(
-                f"(3) SM {env.split('/')[-1]:18s} ({runs} runs): gqn-adaptive {ours:.4f} vs decqn-9 {theirs:.4f} "
-                f"({sm_difference:+.4f} [{sm_interval[0]:+.4f}, {sm_interval[1]:+.4f}])"
-            )
-        ours, sac, return_difference, return_interval, runs, sac_runs = walker_item(table)
-        print(
-            f"(4) walker-walk return: gqn-adaptive {ours:.0f} ({runs} runs) vs SAC {sac:.0f} ({sac_runs} runs), "
-            f"{return_difference:+.0f} [{return_interval[0]:+.0f}, {return_interval[1]:+.0f}]"
-        )
+    for items in (online, average):
+        print("\n".join(text_lines(items)))
     state = "complete: the bar's items above are D5's outcome" if complete(probe) else "partial (D5 waits for seeds 0-11)"
     print(f"D5: {state}")
     return 0
