@@ -187,7 +187,7 @@ def text_lines(items: Items) -> list[str]:
 
 
 def seed_ranges(probe: pd.DataFrame) -> str:
-    """The seeds both agents finished per task, e.g. ``cartpole-swingup 0-4, finger-spin 0-3`` (gaps listed)."""
+    """The seeds both agents finished per task, e.g. ``cartpole-swingup 0-4; finger-spin 0, 1, 3`` (a gap lists the seeds)."""
     parts = []
     for env in TASKS:
         rows = probe[(probe["env"] == env) & (probe["network"] == "average")]
