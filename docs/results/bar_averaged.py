@@ -204,8 +204,8 @@ def seed_ranges(probe: pd.DataFrame) -> str:
 def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[str]:
     """The results report's D5 table: one row per item, the online reading beside the average's."""
 
-    def failures(count: int, pairs: int, listed: list[str]) -> str:
-        return f"{count} of {pairs}" + (f" ({'; '.join(listed)})" if listed else "")
+    def failures(pairs: int, failed: list[str]) -> str:
+        return f"{len(failed)} of {pairs}" + (f" ({'; '.join(failed)})" if failed else "")
 
     def iqm(items: Items) -> str:
         low, high = items.iqm_interval
@@ -221,17 +221,11 @@ def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[s
     rows = [
         (
             "no collapse: growth events failed",
-            *(
-                failures(len(items.growth.growth_failed), items.growth.growth_pairs, items.growth.growth_failed)
-                for items in (online, average)
-            ),
+            *(failures(items.growth.growth_pairs, items.growth.growth_failed) for items in (online, average)),
         ),
         (
             "pairs after the last growth from 30k failing the criterion (reported, not an item)",
-            *(
-                failures(len(items.growth.late_failed), items.growth.late_pairs, items.growth.late_failed)
-                for items in (online, average)
-            ),
+            *(failures(items.growth.late_pairs, items.growth.late_failed) for items in (online, average)),
         ),
         (
             "IQM of normalized final return, gqn-adaptive vs decqn-9 (decqn-2, gqn-linear: the tables')",
