@@ -902,3 +902,94 @@ def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row(
         "| 717 vs 369 (+348 [+200, +400]) |"
     )
     assert len(table) == 9
+
+
+def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_reading_beside():
+    from acting_default import NetworkReading
+    from bar_averaged import Items, bar_rows, linear_growth, status
+
+    assert status({"cartpole": True, "finger": True, "walker": True}) == "met"
+    assert status({"cartpole": False, "finger": False}) == "missed"
+    assert status({"cartpole": True, "finger": False, "walker": False}) == "met on cartpole, missed on finger and walker"
+    assert status({"cartpole": True, "finger": True, "walker": False}) == "met on cartpole and finger, missed on walker"
+
+    def run(seed: int, returns: list[float], events: str) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "algo": "gqn-linear",
+                "env": "dm_control/cartpole-swingup-v0",
+                "penalty": 0.1,
+                "seed": seed,
+                "step": [10_000, 20_000, 30_000],
+                "return": returns,
+                "growth_events": events,
+            }
+        )
+
+    # seed 0: 5k comes before any evaluation (unscored); the warm-started 20k growth pairs 400 (at 20k) with 200 (30k),
+    # 50 % < 70 %: fails. seed 1: 80 -> 40 around 15k, below 100 and within 50: holds. decqn-9's rows are not read.
+    tables = pd.concat(
+        [
+            run(0, [100.0, 400.0, 200.0], "5000:3 20000:5"),
+            run(1, [80.0, 40.0, 500.0], "15000:3"),
+            run(2, [300.0, 0.0, 0.0], "15000:3").assign(algo="decqn-9"),
+        ],
+        ignore_index=True,
+    )
+    assert linear_growth(tables) == (1, 2)
+
+    cartpole, finger, walker = (f"dm_control/{task}-v0" for task in ["cartpole-swingup", "finger-spin", "walker-walk"])
+
+    def items(network: str, failed: list[str], iqm: dict[str, float], sm_finger: float, walker_return: float) -> Items:
+        sm = {
+            cartpole: (0.0040, 0.0050, -0.0010, (-0.0020, 0.0001), 12, 12),
+            finger: (sm_finger, 0.0150, sm_finger - 0.0150, (-0.0030, 0.0040), 12, 12),
+            walker: (0.0120, 0.0110, 0.0010, (0.0001, 0.0020), 12, 12),
+        }
+        return Items(
+            network,
+            NetworkReading("gqn-adaptive", network, 36, 100, failed, 90, [], 0.0, 0.0),
+            iqm,
+            iqm["gqn-adaptive"] - iqm["decqn-9"],
+            (0.05, 0.30),
+            sm,
+            (walker_return, 369.4, walker_return - 369.4, (walker_return - 469.4, walker_return - 269.4), 12, 12),
+        )
+
+    # the average: no adaptive failure, the IQM above both, SM met on cartpole and finger (0.0150 <= 0.0150), walker
+    # above SAC; the online network fails once, misses the IQM against decqn-2 and finger's SM, and trails SAC
+    average = items("average", [], {"gqn-adaptive": 0.90, "decqn-9": 0.72, "decqn-2": 0.20}, 0.0150, 701.0)
+    online = items(
+        "online",
+        ["finger seed 3 -> 5 bins: 121 -> 66"],
+        {"gqn-adaptive": 0.19, "decqn-9": 0.10, "decqn-2": 0.20},
+        0.016,
+        300.0,
+    )
+    rows = bar_rows(average, online, (50, 54))
+    assert len(rows) == 4
+    # gqn-linear's recorded misses keep the collapse item missed even with no adaptive failure on the average
+    assert rows[0].split(" | ")[1:] == [
+        "missed",
+        "gqn-adaptive on the average 100 of 100 scored events hold; online 99 of 100 scored events hold "
+        "(finger seed 3 -> 5 bins: 121 -> 66); gqn-linear (online, as recorded) 50 of 54 |",
+    ]
+    assert bar_rows(average, online, (54, 54))[0].split(" | ")[1] == "met"
+    assert rows[1].split(" | ")[1:] == [
+        "met",
+        "on the average 0.90 against decqn-9's 0.72 (+0.18 [+0.05, +0.30]) and decqn-2's 0.20; online 0.19 against "
+        "decqn-9's 0.10 (+0.09 [+0.05, +0.30]) and decqn-2's 0.20; seeds 0-7 of each task |",
+    ]
+    assert rows[2].split(" | ")[1] == "met on cartpole and finger, missed on walker"
+    assert rows[2].endswith(
+        "online cartpole 0.0040 vs 0.0050 (-0.0010 [-0.0020, +0.0001]); finger 0.0160 vs 0.0150 (+0.0010 [-0.0030, "
+        "+0.0040]); walker 0.0120 vs 0.0110 (+0.0010 [+0.0001, +0.0020]); cartpole 12, finger 12, walker 12 runs a side |"
+    )
+    assert rows[3].split(" | ")[1:] == [
+        "met",
+        "on the average 701 vs 369 (+332 [+232, +432]); online 300 vs 369 (-69 [-169, +31]); 12 runs against SAC's 12 |",
+    ]
+    # a status read on the online network would differ: the rows read the average
+    flipped = bar_rows(online, average, (50, 54))
+    statuses = [row.split(" | ")[1] for row in flipped]
+    assert statuses == ["missed", "missed", "met on cartpole, missed on finger and walker", "missed"]

@@ -8,9 +8,13 @@ tables' rows of the same agent, task and seed (``readme_tables.shipped``). Then,
 gqn-adaptive's growth events that fail the collapse criterion; (2) the IQM of normalized final return over seeds 0-7
 (the tables' other agents and seeds keep their rows, so the normalization is the bar's); (3) the mean final SM per
 task, gqn-adaptive against decqn-9; (4) walker-walk's mean final return, gqn-adaptive against SAC's recorded runs.
-``--markdown`` prints the items as the results report's table (online and average side by side).
+``--markdown`` prints the items as the results report's table (online and average side by side); ``--bar`` prints
+the README bar table's rows of those items once D5 is complete: each item's status read on the average (what
+``predict`` acts on), the online reading beside it. The table's other row (9 bins within 100k steps) is read from
+training alone and stays as recorded; so does gqn-linear's part of the collapse item (its runs act on the online
+network), counted here from the tables.
 
-    .venv/bin/python docs/results/bar_averaged.py [--markdown]
+    .venv/bin/python docs/results/bar_averaged.py [--markdown | --bar]
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from acting_default import complete as complete_on
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
 from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores
-from sb3_gqn.report import load
+from sb3_gqn.report import growth_checks, load
 from sb3_gqn.significance import difference_interval, iqm_difference, mean_difference
 
 RESULTS = Path(__file__).resolve().parent
@@ -251,10 +255,86 @@ def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[s
     ]
 
 
+def linear_growth(tables: pd.DataFrame) -> tuple[int, int]:
+    """How many of gqn-linear's scored growth events in ``tables`` hold the collapse criterion, and how many there are
+    (a growth before the first evaluation is unscored, as in the bar)."""
+    scored = [check for check in growth_checks(tables[tables["algo"] == "gqn-linear"]) if check.held is not None]
+    return sum(bool(check.held) for check in scored), len(scored)
+
+
+def joined(names: list[str]) -> str:
+    """``["a", "b", "c"]`` -> ``a, b and c``."""
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def status(met: dict[str, bool]) -> str:
+    """``met`` or ``missed`` when every part agrees, else ``met on <parts>, missed on <parts>``."""
+    if all(met.values()):
+        return "met"
+    if not any(met.values()):
+        return "missed"
+    met_on, missed_on = ([part for part, ok in met.items() if bool(ok) == wanted] for wanted in (True, False))
+    return f"met on {joined(met_on)}, missed on {joined(missed_on)}"
+
+
+def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str]:
+    """The README bar table's rows of D5's items: no collapse, IQM, SM per task, walker-walk against SAC. Each row's
+    status is read on ``average``; the figures give the average's reading, then the online network's of the same
+    runs. ``linear``: gqn-linear's (held, scored) growth events as recorded (``linear_growth``)."""
+
+    def interval(difference: float, bounds: tuple[float, float], digits: int) -> str:
+        return f"{difference:+.{digits}f} [{bounds[0]:+.{digits}f}, {bounds[1]:+.{digits}f}]"
+
+    def held(items: Items) -> str:
+        growth = items.growth
+        failed = growth.growth_failed
+        return f"{growth.growth_pairs - len(failed)} of {growth.growth_pairs} scored events hold" + (
+            f" ({'; '.join(failed)})" if failed else ""
+        )
+
+    def iqm(items: Items) -> str:
+        return (
+            f"{items.iqm['gqn-adaptive']:.2f} against decqn-9's {items.iqm['decqn-9']:.2f} "
+            f"({interval(items.iqm_difference, items.iqm_interval, 2)}) and decqn-2's {items.iqm['decqn-2']:.2f}"
+        )
+
+    def sm(items: Items) -> str:
+        return "; ".join(
+            f"{short(env).split('-')[0]} {ours:.4f} vs {theirs:.4f} ({interval(difference, bounds, 4)})"
+            for env, (ours, theirs, difference, bounds, _, _) in items.sm.items()
+        )
+
+    def walker(items: Items) -> str:
+        ours, sac, difference, bounds, _, _ = items.walker
+        return f"{ours:.0f} vs {sac:.0f} ({interval(difference, bounds, 0)})"
+
+    linear_held, linear_scored = linear
+    runs = {short(env).split("-")[0]: values[4] for env, values in average.sm.items()}
+    sac_runs = average.walker[5]
+    # the target holds for every GQN run: one miss of either agent misses it
+    collapse = "met" if not average.growth.growth_failed and linear_held == linear_scored else "missed"
+    iqm_met = all(average.iqm["gqn-adaptive"] >= average.iqm[other] for other in ["decqn-9", "decqn-2"])
+    sm_met = {short(env).split("-")[0]: values[0] <= values[1] for env, values in average.sm.items()}
+    return [
+        "| no collapse: the first evaluation after a growth >= 70 % of the last before it (within 50 below 100) "
+        f"| {collapse} | gqn-adaptive on the average {held(average)}; online {held(online)}; "
+        f"gqn-linear (online, as recorded) {linear_held} of {linear_scored} |",
+        f"| IQM of normalized final return: gqn-adaptive >= decqn-9 and >= decqn-2 | {'met' if iqm_met else 'missed'} "
+        f"| on the average {iqm(average)}; online {iqm(online)}; seeds 0-{IQM_RUNS - 1} of each task |",
+        f"| SM: gqn-adaptive <= decqn-9 on each task | {status(sm_met)} | on the average {sm(average)}; online "
+        f"{sm(online)}; " + ", ".join(f"{task} {count}" for task, count in runs.items()) + " runs a side |",
+        f"| walker-walk: gqn-adaptive >= SAC | {'met' if average.walker[0] >= average.walker[1] else 'missed'} "
+        f"| on the average {walker(average)}; online {walker(online)}; {average.walker[4]} runs against SAC's "
+        f"{sac_runs} |",
+    ]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folders", type=Path, nargs="+", default=FOLDERS, help="probe folders, one subfolder per task")
-    parser.add_argument("--markdown", action="store_true", help="print the items as the results report's table")
+    printed = parser.add_mutually_exclusive_group()
+    printed.add_argument("--markdown", action="store_true", help="print the items as the results report's table")
+    printed.add_argument("--bar", action="store_true", help="print the README bar table's rows (D5 complete only)")
     args = parser.parse_args(argv)
     probe = probe_rows(args.folders)
     tables = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
@@ -262,6 +342,12 @@ def main(argv: list[str] | None = None) -> int:
     online, average = (read_items(tables, probe, network) for network in ["online", "average"])
     if args.markdown:
         print("\n".join(markdown_table(probe, online, average)))
+        return 0
+    if args.bar:
+        if not complete(probe):
+            print("D5 is partial (both agents need seeds 0-11 on all three tasks): the bar keeps the tables' status")
+            return 1
+        print("\n".join(bar_rows(average, online, linear_growth(tables))))
         return 0
     compared, mismatches = determinism_mismatches(probe, tables)
     print(f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ")
