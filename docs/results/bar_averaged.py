@@ -205,6 +205,17 @@ def seed_ranges(probe: pd.DataFrame) -> str:
     return "; ".join(parts)
 
 
+def interval(difference: float, bounds: tuple[float, float], digits: int) -> str:
+    """A difference and its 95 % interval, signed: ``+0.0020 [-0.0010, +0.0050]``."""
+    return f"{difference:+.{digits}f} [{bounds[0]:+.{digits}f}, {bounds[1]:+.{digits}f}]"
+
+
+def compared(values: Means, digits: int) -> str:
+    """``final_means`` as ``ours vs theirs (difference [low, high])``."""
+    ours, theirs, difference, bounds, _, _ = values
+    return f"{ours:.{digits}f} vs {theirs:.{digits}f} ({interval(difference, bounds, digits)})"
+
+
 def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[str]:
     """The results report's D5 table: one row per item, the online reading beside the average's."""
 
@@ -212,15 +223,10 @@ def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[s
         return f"{len(failed)} of {pairs}" + (f" ({'; '.join(failed)})" if failed else "")
 
     def iqm(items: Items) -> str:
-        low, high = items.iqm_interval
         return (
             f"{items.iqm['gqn-adaptive']:.2f} vs {items.iqm['decqn-9']:.2f} "
-            f"({items.iqm_difference:+.2f} [{low:+.2f}, {high:+.2f}])"
+            f"({interval(items.iqm_difference, items.iqm_interval, 2)})"
         )
-
-    def means(values: Means, digits: int) -> str:
-        ours, theirs, difference, (low, high), _, _ = values
-        return f"{ours:.{digits}f} vs {theirs:.{digits}f} ({difference:+.{digits}f} [{low:+.{digits}f}, {high:+.{digits}f}])"
 
     rows = [
         (
@@ -240,12 +246,12 @@ def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[s
     for env in TASKS:
         runs, other_runs = online.sm[env][4:]
         side = f"{runs} runs a side" if runs == other_runs else f"{runs} and {other_runs} runs"
-        rows.append((f"SM {short(env)} ({side})", means(online.sm[env], 4), means(average.sm[env], 4)))
+        rows.append((f"SM {short(env)} ({side})", compared(online.sm[env], 4), compared(average.sm[env], 4)))
     rows.append(
         (
             f"walker-walk return, gqn-adaptive vs SAC ({online.walker[5]} recorded runs)",
-            means(online.walker, 0),
-            means(average.walker, 0),
+            compared(online.walker, 0),
+            compared(average.walker, 0),
         )
     )
     return [
@@ -269,11 +275,12 @@ def joined(names: list[str]) -> str:
 
 def status(met: dict[str, bool]) -> str:
     """``met`` or ``missed`` when every part agrees, else ``met on <parts>, missed on <parts>``."""
-    if all(met.values()):
+    met_on = [part for part, ok in met.items() if ok]
+    missed_on = [part for part, ok in met.items() if not ok]
+    if not missed_on:
         return "met"
-    if not any(met.values()):
+    if not met_on:
         return "missed"
-    met_on, missed_on = ([part for part, ok in met.items() if bool(ok) == wanted] for wanted in (True, False))
     return f"met on {joined(met_on)}, missed on {joined(missed_on)}"
 
 
@@ -281,9 +288,6 @@ def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str
     """The README bar table's rows of D5's items: no collapse, IQM, SM per task, walker-walk against SAC. Each row's
     status is read on ``average``; the figures give the average's reading, then the online network's of the same
     runs. ``linear``: gqn-linear's (held, scored) growth events as recorded (``linear_growth``)."""
-
-    def interval(difference: float, bounds: tuple[float, float], digits: int) -> str:
-        return f"{difference:+.{digits}f} [{bounds[0]:+.{digits}f}, {bounds[1]:+.{digits}f}]"
 
     def held(items: Items) -> str:
         growth = items.growth
@@ -298,23 +302,16 @@ def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str
             f"({interval(items.iqm_difference, items.iqm_interval, 2)}) and decqn-2's {items.iqm['decqn-2']:.2f}"
         )
 
-    def sm(items: Items) -> str:
-        return "; ".join(
-            f"{short(env).split('-')[0]} {ours:.4f} vs {theirs:.4f} ({interval(difference, bounds, 4)})"
-            for env, (ours, theirs, difference, bounds, _, _) in items.sm.items()
-        )
+    tasks = {env: short(env).split("-")[0] for env in average.sm}
 
-    def walker(items: Items) -> str:
-        ours, sac, difference, bounds, _, _ = items.walker
-        return f"{ours:.0f} vs {sac:.0f} ({interval(difference, bounds, 0)})"
+    def sm(items: Items) -> str:
+        return "; ".join(f"{tasks[env]} {compared(values, 4)}" for env, values in items.sm.items())
 
     linear_held, linear_scored = linear
-    runs = {short(env).split("-")[0]: values[4] for env, values in average.sm.items()}
-    sac_runs = average.walker[5]
     # the target holds for every GQN run: one miss of either agent misses it
     collapse = "met" if not average.growth.growth_failed and linear_held == linear_scored else "missed"
     iqm_met = all(average.iqm["gqn-adaptive"] >= average.iqm[other] for other in ["decqn-9", "decqn-2"])
-    sm_met = {short(env).split("-")[0]: values[0] <= values[1] for env, values in average.sm.items()}
+    sm_met = {tasks[env]: values[0] <= values[1] for env, values in average.sm.items()}
     return [
         "| no collapse: the first evaluation after a growth >= 70 % of the last before it (within 50 below 100) "
         f"| {collapse} | gqn-adaptive on the average {held(average)}; online {held(online)}; "
@@ -322,10 +319,10 @@ def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str
         f"| IQM of normalized final return: gqn-adaptive >= decqn-9 and >= decqn-2 | {'met' if iqm_met else 'missed'} "
         f"| on the average {iqm(average)}; online {iqm(online)}; seeds 0-{IQM_RUNS - 1} of each task |",
         f"| SM: gqn-adaptive <= decqn-9 on each task | {status(sm_met)} | on the average {sm(average)}; online "
-        f"{sm(online)}; " + ", ".join(f"{task} {count}" for task, count in runs.items()) + " runs a side |",
+        f"{sm(online)}; " + ", ".join(f"{tasks[env]} {values[4]}" for env, values in average.sm.items()) + " runs a side |",
         f"| walker-walk: gqn-adaptive >= SAC | {'met' if average.walker[0] >= average.walker[1] else 'missed'} "
-        f"| on the average {walker(average)}; online {walker(online)}; {average.walker[4]} runs against SAC's "
-        f"{sac_runs} |",
+        f"| on the average {compared(average.walker, 0)}; online {compared(online.walker, 0)}; {average.walker[4]} runs "
+        f"against SAC's {average.walker[5]} |",
     ]
 
 
