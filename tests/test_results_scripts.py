@@ -902,6 +902,17 @@ def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row(
         "| 717 vs 369 (+348 [+200, +400]) |"
     )
     assert len(table) == 9
+    # with gqn-linear's D6 readings (online, average), their growth events get a row under gqn-adaptive's
+    linear = tuple(
+        NetworkReading("gqn-linear", network, 18, 54, failed, 40, [], 0.0, 0.0)
+        for network, failed in [("online", ["cartpole-swingup-v0 seed 1 -> 3 bins: 400 -> 200"]), ("average", [])]
+    )
+    with_linear = markdown_table(probe, items("online", [], 695.2), items("average", [], 717.0), linear)  # type: ignore[arg-type]
+    assert len(with_linear) == 10 and with_linear[2].startswith("| no collapse: growth events failed |")
+    assert with_linear[3] == (
+        "| gqn-linear's growth events failed (rule D6, 18 runs) "
+        "| 1 of 54 (cartpole-swingup-v0 seed 1 -> 3 bins: 400 -> 200) | 0 of 54 |"
+    )
 
 
 def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_reading_beside():
@@ -966,7 +977,8 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
         0.016,
         300.0,
     )
-    rows = bar_rows(average, online, (50, 54))
+    recorded = "gqn-linear (online, as recorded) 50 of 54"
+    rows = bar_rows(average, online, (recorded, False))
     assert len(rows) == 4
     # gqn-linear's recorded misses keep the collapse item missed even with no adaptive failure on the average
     assert rows[0].split(" | ")[1:] == [
@@ -974,7 +986,7 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
         "gqn-adaptive on the average 100 of 100 scored events hold; online 99 of 100 scored events hold "
         "(finger seed 3 -> 5 bins: 121 -> 66); gqn-linear (online, as recorded) 50 of 54 |",
     ]
-    assert bar_rows(average, online, (54, 54))[0].split(" | ")[1] == "met"
+    assert bar_rows(average, online, ("gqn-linear (online, as recorded) 54 of 54", True))[0].split(" | ")[1] == "met"
     assert rows[1].split(" | ")[1:] == [
         "met",
         "on the average 0.90 against decqn-9's 0.72 (+0.18 [+0.05, +0.30]) and decqn-2's 0.20; online 0.19 against "
@@ -990,6 +1002,67 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
         "on the average 701 vs 369 (+332 [+232, +432]); online 300 vs 369 (-69 [-169, +31]); 12 runs against SAC's 12 |",
     ]
     # a status read on the online network would differ: the rows read the average
-    flipped = bar_rows(online, average, (50, 54))
+    flipped = bar_rows(online, average, (recorded, False))
     statuses = [row.split(" | ")[1] for row in flipped]
     assert statuses == ["missed", "missed", "met on cartpole, missed on finger and walker", "missed"]
+
+
+def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run(tmp_path: Path):
+    from acting_default import TASKS
+    from bar_averaged import LINEAR_SEEDS, linear_complete, linear_part, linear_probe_rows
+
+    def rows(algo: str, env: str, seed: int, returns: list[float]) -> pd.DataFrame:
+        # one growth to 3 bins at 15k, between the evaluations at 10k and 20k
+        return pd.DataFrame(
+            {
+                "algo": algo,
+                "env": env,
+                "penalty": 0.1,
+                "seed": seed,
+                "step": [10_000, 20_000],
+                "return": returns,
+                "smoothness": [0.02, 0.01],
+                "active_bins": [2, 3],
+                "growth_events": "15000:3",
+            }
+        )
+
+    cartpole = TASKS[0]
+    # the tables' recorded gqn-linear run: 400 -> 250 fails (62 % < 70 %)
+    tables = rows("gqn-linear", cartpole, 0, [400.0, 250.0])
+    assert linear_probe_rows(tmp_path / "none") is None and not linear_complete(None)
+    assert linear_part(tables, None) == ("gqn-linear (online, as recorded) 0 of 1", False)
+
+    folder = tmp_path / "cartpole"
+    (folder / "online").mkdir(parents=True)
+    rows("gqn-linear+avg0.001", cartpole, 0, [400.0, 380.0]).to_csv(folder / "results.csv", index=False)
+    rows("gqn-linear", cartpole, 0, [400.0, 200.0]).to_csv(folder / "online" / "a.csv", index=False)
+    partial = linear_probe_rows(tmp_path)
+    assert partial is not None and len(partial) == 4 and not linear_complete(partial)
+    # one run of 18: the bar keeps the recorded count
+    assert linear_part(tables, partial) == ("gqn-linear (online, as recorded) 0 of 1", False)
+
+    # every task and seed: the average holds 380 / 400 = 95 % everywhere, the online network fails cartpole seed 0
+    every = pd.concat(
+        [
+            frame.assign(network=network)
+            for task in TASKS
+            for seed in LINEAR_SEEDS
+            for network, frame in [
+                ("average", rows("gqn-linear", task, seed, [400.0, 380.0])),
+                ("online", rows("gqn-linear", task, seed, [400.0, 200.0 if (task, seed) == (cartpole, 0) else 380.0])),
+            ]
+        ],
+        ignore_index=True,
+    )
+    assert linear_complete(every) and not linear_complete(every[every["seed"] != 5])
+    assert linear_part(tables, every) == (
+        "gqn-linear on the average 18 of 18 scored events hold; online 17 of 18 scored events hold "
+        "(cartpole-swingup-v0 seed 0 -> 3 bins: 400 -> 200)",
+        True,
+    )
+    # a failure on the average fails the part
+    failing = every.copy()
+    failing.loc[(failing["network"] == "average") & (failing["seed"] == 3) & (failing["step"] == 20_000), "return"] = 100.0
+    text, holds = linear_part(tables, failing)
+    assert not holds and text.startswith("gqn-linear on the average 15 of 18 scored events hold")

@@ -11,8 +11,11 @@ task, gqn-adaptive against decqn-9; (4) walker-walk's mean final return, gqn-ada
 ``--markdown`` prints the items as the results report's table (online and average side by side); ``--bar`` prints
 the README bar table's rows of those items once D5 is complete: each item's status read on the average (what
 ``predict`` acts on), the online reading beside it. The table's other row (9 bins within 100k steps) is read from
-training alone and stays as recorded; so does gqn-linear's part of the collapse item (its runs act on the online
-network), counted here from the tables.
+training alone and stays as recorded.
+
+gqn-linear's part of the collapse item (rule D6): its runs in ``probes/bar_averaged_linear/`` (seeds 0-5, the tables'
+seeds, same probe) are checked against the tables and read on both networks; until all 18 have finished, the bar's
+row keeps gqn-linear's count as the tables recorded it (online).
 
     .venv/bin/python docs/results/bar_averaged.py [--markdown | --bar]
 """
@@ -36,6 +39,9 @@ from sb3_gqn.significance import difference_interval, iqm_difference, mean_diffe
 RESULTS = Path(__file__).resolve().parent
 FOLDERS = [RESULTS / "probes" / "acting_default", RESULTS / "probes" / "bar_averaged"]
 SEEDS_FOR_OUTCOME = list(range(12))
+#: rule D6: gqn-linear read on the average, on the tables' seeds of gqn-linear
+LINEAR_FOLDER = RESULTS / "probes" / "bar_averaged_linear"
+LINEAR_SEEDS = list(range(6))
 WALKER = "dm_control/walker-walk-v0"
 #: what the check compares at every evaluation, and how closely
 CHECKED = ["return", "smoothness", "active_bins"]
@@ -216,8 +222,11 @@ def compared(values: Means, digits: int) -> str:
     return f"{ours:.{digits}f} vs {theirs:.{digits}f} ({interval(difference, bounds, digits)})"
 
 
-def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[str]:
-    """The results report's D5 table: one row per item, the online reading beside the average's."""
+def markdown_table(
+    probe: pd.DataFrame, online: Items, average: Items, linear: tuple[NetworkReading, NetworkReading] | None = None
+) -> list[str]:
+    """The results report's D5 table: one row per item, the online reading beside the average's; with ``linear``
+    (gqn-linear's D6 readings, online and average), a row for its growth events under the collapse item's."""
 
     def failures(pairs: int, failed: list[str]) -> str:
         return f"{len(failed)} of {pairs}" + (f" ({'; '.join(failed)})" if failed else "")
@@ -232,6 +241,16 @@ def markdown_table(probe: pd.DataFrame, online: Items, average: Items) -> list[s
         (
             "no collapse: growth events failed",
             *(failures(items.growth.growth_pairs, items.growth.growth_failed) for items in (online, average)),
+        ),
+        *(
+            [
+                (
+                    f"gqn-linear's growth events failed (rule D6, {linear[1].runs} runs)",
+                    *(failures(reading.growth_pairs, reading.growth_failed) for reading in linear),
+                )
+            ]
+            if linear is not None
+            else []
         ),
         (
             "pairs after the last growth from 30k failing the criterion (reported, not an item)",
@@ -268,6 +287,39 @@ def linear_growth(tables: pd.DataFrame) -> tuple[int, int]:
     return sum(bool(check.held) for check in scored), len(scored)
 
 
+def linear_probe_rows(folder: Path = LINEAR_FOLDER) -> pd.DataFrame | None:
+    """D6's runs of gqn-linear, paired as D4's (``probe_rows``); ``None`` before any has finished."""
+    return probe_rows([folder]) if any(folder.glob("*/results.csv")) else None
+
+
+def linear_complete(linear_probe: pd.DataFrame | None) -> bool:
+    """Whether gqn-linear finished ``LINEAR_SEEDS`` on all three tasks (D6's outcome waits for it)."""
+    if linear_probe is None:
+        return False
+    done = set(map(tuple, linear_probe[linear_probe["network"] == "average"][["env", "seed"]].drop_duplicates().to_numpy()))
+    return all((task, seed) in done for task in TASKS for seed in LINEAR_SEEDS)
+
+
+def held(reading: NetworkReading) -> str:
+    """``N of M scored events hold`` and the failed events."""
+    failed = reading.growth_failed
+    return f"{reading.growth_pairs - len(failed)} of {reading.growth_pairs} scored events hold" + (
+        f" ({'; '.join(failed)})" if failed else ""
+    )
+
+
+def linear_part(tables: pd.DataFrame, linear_probe: pd.DataFrame | None) -> tuple[str, bool]:
+    """gqn-linear's part of the bar's collapse row and whether it holds: once D6 is complete, its events on the average
+    with the online reading beside (the status reads the average); before that, the tables' online count."""
+    if linear_complete(linear_probe):
+        average, online = (
+            read_network(linear_probe, "gqn-linear", network, start=30_000) for network in ["average", "online"]
+        )
+        return f"gqn-linear on the average {held(average)}; online {held(online)}", not average.growth_failed
+    linear_held, linear_scored = linear_growth(tables)
+    return f"gqn-linear (online, as recorded) {linear_held} of {linear_scored}", linear_held == linear_scored
+
+
 def joined(names: list[str]) -> str:
     """``["a", "b", "c"]`` -> ``a, b and c``."""
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
@@ -284,17 +336,10 @@ def status(met: dict[str, bool]) -> str:
     return f"met on {joined(met_on)}, missed on {joined(missed_on)}"
 
 
-def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str]:
+def bar_rows(average: Items, online: Items, linear: tuple[str, bool]) -> list[str]:
     """The README bar table's rows of D5's items: no collapse, IQM, SM per task, walker-walk against SAC. Each row's
     status is read on ``average``; the figures give the average's reading, then the online network's of the same
-    runs. ``linear``: gqn-linear's (held, scored) growth events as recorded (``linear_growth``)."""
-
-    def held(items: Items) -> str:
-        growth = items.growth
-        failed = growth.growth_failed
-        return f"{growth.growth_pairs - len(failed)} of {growth.growth_pairs} scored events hold" + (
-            f" ({'; '.join(failed)})" if failed else ""
-        )
+    runs. ``linear``: gqn-linear's part of the collapse row and whether it holds (``linear_part``)."""
 
     def iqm(items: Items) -> str:
         return (
@@ -307,15 +352,15 @@ def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str
     def sm(items: Items) -> str:
         return "; ".join(f"{tasks[env]} {compared(values, 4)}" for env, values in items.sm.items())
 
-    linear_held, linear_scored = linear
+    linear_text, linear_holds = linear
     # the target holds for every GQN run: one miss of either agent misses it
-    collapse = "met" if not average.growth.growth_failed and linear_held == linear_scored else "missed"
+    collapse = "met" if not average.growth.growth_failed and linear_holds else "missed"
     iqm_met = all(average.iqm["gqn-adaptive"] >= average.iqm[other] for other in ["decqn-9", "decqn-2"])
     sm_met = {tasks[env]: values[0] <= values[1] for env, values in average.sm.items()}
     return [
         "| no collapse: the first evaluation after a growth >= 70 % of the last before it (within 50 below 100) "
-        f"| {collapse} | gqn-adaptive on the average {held(average)}; online {held(online)}; "
-        f"gqn-linear (online, as recorded) {linear_held} of {linear_scored} |",
+        f"| {collapse} | gqn-adaptive on the average {held(average.growth)}; online {held(online.growth)}; "
+        f"{linear_text} |",
         f"| IQM of normalized final return: gqn-adaptive >= decqn-9 and >= decqn-2 | {'met' if iqm_met else 'missed'} "
         f"| on the average {iqm(average)}; online {iqm(online)}; seeds 0-{IQM_RUNS - 1} of each task |",
         f"| SM: gqn-adaptive <= decqn-9 on each task | {status(sm_met)} | on the average {sm(average)}; online "
@@ -329,6 +374,7 @@ def bar_rows(average: Items, online: Items, linear: tuple[int, int]) -> list[str
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folders", type=Path, nargs="+", default=FOLDERS, help="probe folders, one subfolder per task")
+    parser.add_argument("--linear-folder", type=Path, default=LINEAR_FOLDER, help="D6's folder of gqn-linear runs")
     printed = parser.add_mutually_exclusive_group()
     printed.add_argument("--markdown", action="store_true", help="print the items as the results report's table")
     printed.add_argument("--bar", action="store_true", help="print the README bar table's rows (D5 complete only)")
@@ -337,14 +383,20 @@ def main(argv: list[str] | None = None) -> int:
     tables = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
     tables = tables[tables["algo"].isin([*MAIN_ALGOS, "sac"])]
     online, average = (read_items(tables, probe, network) for network in ["online", "average"])
+    linear_probe = linear_probe_rows(args.linear_folder)
+    linear = (
+        None
+        if linear_probe is None
+        else tuple(read_network(linear_probe, "gqn-linear", network, start=30_000) for network in ["online", "average"])
+    )
     if args.markdown:
-        print("\n".join(markdown_table(probe, online, average)))
+        print("\n".join(markdown_table(probe, online, average, linear)))  # type: ignore[arg-type]
         return 0
     if args.bar:
         if not complete(probe):
             print("D5 is partial (both agents need seeds 0-11 on all three tasks): the bar keeps the tables' status")
             return 1
-        print("\n".join(bar_rows(average, online, linear_growth(tables))))
+        print("\n".join(bar_rows(average, online, linear_part(tables, linear_probe))))
         return 0
     compared, mismatches = determinism_mismatches(probe, tables)
     print(f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ")
@@ -360,6 +412,30 @@ def main(argv: list[str] | None = None) -> int:
         print("\n".join(text_lines(items)))
     state = "complete: the bar's items above are D5's outcome" if complete(probe) else "partial (D5 waits for seeds 0-11)"
     print(f"D5: {state}")
+    if linear_probe is not None and linear is not None:
+        compared, mismatches = determinism_mismatches(linear_probe, tables)
+        print(f"--- gqn-linear (rule D6)\ncheck: {compared} probe runs have table rows; {len(mismatches)} of them differ")
+        for line in mismatches:
+            print(f"    {line}")
+        read = linear_probe[linear_probe["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
+        for env, seeds_read in read.items():
+            print(f"runs read: {str(env).split('/')[-1]:18s} gqn-linear    seeds {seeds_read}")
+        for line in final_lines(linear_probe):
+            print(f"    {line}")
+        for reading in linear:
+            print(
+                f"{reading.network}: growth events failed {len(reading.growth_failed)} of {reading.growth_pairs}; pairs "
+                f"after the last growth from 30k (reported) {len(reading.late_failed)} of {reading.late_pairs}; mean "
+                f"final return {reading.final_return:.1f}, SM {reading.final_sm:.4f}"
+            )
+            for failure in reading.growth_failed + reading.late_failed:
+                print(f"    {failure}")
+    linear_state = (
+        "complete: the bar's collapse row reads gqn-linear on the average"
+        if linear_complete(linear_probe)
+        else ("partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)")
+    )
+    print(f"D6: {linear_state}")
     return 0
 
 

@@ -14,7 +14,12 @@ each agent's runs with replacement, independently (2 000 replicates, seed 0; a r
 together). ``explained`` is the share of the raw mean difference that the task-return term accounts for
 (``1 - d / raw``). A diagnostic: the bar's item stays the raw comparison.
 
+``--network average`` (or ``online``) reads D4's and D5's probe runs instead of the tables (rule D5,
+``decision_rules.md``; ``bar_averaged.probe_rows``): the same 12 runs a side per task, acting on the averaged network
+``predict`` acts on by default, or on the online network of the same evaluations.
+
     .venv/bin/python docs/results/smoothness_at_matched_return.py
+    .venv/bin/python docs/results/smoothness_at_matched_return.py --network average
     .venv/bin/python docs/results/smoothness_at_matched_return.py --pairs gqn-linear:decqn-9
 """
 
@@ -25,6 +30,7 @@ import sys
 
 import numpy as np
 import pandas as pd
+from bar_averaged import FOLDERS, probe_rows
 from readme_tables import MAIN_TABLES, RESULTS, shipped
 
 from sb3_gqn.plots import final_rows
@@ -83,15 +89,27 @@ def comparison(final: pd.DataFrame, env: str, agent_x: str, agent_y: str) -> dic
         "raw SM difference": f"{raw:+.4f}",
         "slope per 100": f"{100 * slope:+.4f}",
         "at matched task return": f"{offset:+.4f} [{low:+.4f}, {high:+.4f}]",
-        "explained": f"{1 - offset / raw:.0%}" if raw else "-",
+        # a raw difference that prints as +0.0000 has no share to explain
+        "explained": f"{1 - offset / raw:.0%}" if abs(raw) >= 5e-5 else "-",
     }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--pairs", nargs="+", default=["gqn-adaptive:decqn-9"], help="agent_x:agent_y, main-table names")
+    parser.add_argument(
+        "--network",
+        choices=["tables", "average", "online"],
+        default="tables",
+        help="the tables' runs (online network, recorded before rule D4), or D4's and D5's probe runs on one network",
+    )
     args = parser.parse_args(argv)
-    final = final_rows(shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES])))
+    if args.network == "tables":
+        table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
+    else:
+        probe = probe_rows(FOLDERS)
+        table = probe[probe["network"] == args.network].drop(columns="network")
+    final = final_rows(table)
     final = final[(final["penalty"] == 0.1) & (final["step"] == STEPS)]
     rows = [
         comparison(final, str(env), *pair.split(":"))
