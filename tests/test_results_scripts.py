@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -912,6 +913,18 @@ def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row(
     assert with_linear[3] == (
         "| gqn-linear's growth events failed (rule D6, 18 runs) "
         "| 1 of 54 (cartpole-swingup-v0 seed 1 -> 3 bins: 400 -> 200) | 0 of 54 |"
+    )
+    # decqn-9's consecutive evaluations, for scale: a row under the late pairs when both networks read them
+    static = NetworkReading("decqn-9", "average", 4, 0, [], 50, ["walker-walk-v0 seed 5 40k -> 50k: 187 -> 119"], 0.0, 0.0)
+    scaled = markdown_table(
+        probe,
+        replace(items("online", [], 695.2), static=replace(static, network="online", late_failed=[])),
+        replace(items("average", [], 717.0), static=static),
+    )
+    assert len(scaled) == 10 and scaled[3].startswith("| pairs after the last growth")
+    assert scaled[4] == (
+        "| for scale: decqn-9's consecutive evaluations from 30k failing the criterion (it never grows) | 0 of 50 "
+        "| 1 of 50 (walker-walk-v0 seed 5 40k -> 50k: 187 -> 119) |"
     )
 
 

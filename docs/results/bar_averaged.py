@@ -148,6 +148,9 @@ class Items:
     iqm_interval: tuple[float, float]
     sm: dict[str, Means]
     walker: Means
+    #: for scale, not an item: decqn-9, which never grows, read as ``growth``'s late pairs (consecutive evaluations
+    #: from 30k that fail the collapse criterion with no growth between them)
+    static: NetworkReading | None = None
 
 
 def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> Items:
@@ -162,6 +165,7 @@ def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> Items
         interval,
         {env: sm_item(table, env) for env in TASKS},
         walker_item(table),
+        read_network(probe, "decqn-9", network, start=30_000),
     )
 
 
@@ -178,6 +182,15 @@ def text_lines(items: Items) -> list[str]:
         f"(1) gqn-adaptive growth events failed {len(growth.growth_failed)} of {growth.growth_pairs}; pairs after "
         f"the last growth from 30k (not an item, reported) {len(growth.late_failed)} of {growth.late_pairs}",
         *(f"    {failure}" for failure in growth.growth_failed + growth.late_failed),
+        *(
+            [
+                f"(for scale) decqn-9, which never grows: consecutive evaluations from 30k failing the criterion "
+                f"{len(items.static.late_failed)} of {items.static.late_pairs}",
+                *(f"    {failure}" for failure in items.static.late_failed),
+            ]
+            if items.static is not None
+            else []
+        ),
         f"(2) IQM (lowest {IQM_RUNS} seeds read): "
         + ", ".join(f"{algo} {value:.2f}" for algo, value in sorted(items.iqm.items()))
         + f"; gqn-adaptive - decqn-9 {items.iqm_difference:+.2f} "
@@ -255,6 +268,16 @@ def markdown_table(
         (
             "pairs after the last growth from 30k failing the criterion (reported, not an item)",
             *(failures(items.growth.late_pairs, items.growth.late_failed) for items in (online, average)),
+        ),
+        *(
+            [
+                (
+                    "for scale: decqn-9's consecutive evaluations from 30k failing the criterion (it never grows)",
+                    *(failures(items.static.late_pairs, items.static.late_failed) for items in (online, average)),  # type: ignore[union-attr]
+                )
+            ]
+            if online.static is not None and average.static is not None
+            else []
         ),
         (
             "IQM of normalized final return, gqn-adaptive vs decqn-9 (decqn-2, gqn-linear: the tables')",
