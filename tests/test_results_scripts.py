@@ -930,9 +930,14 @@ def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row(
 
 def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_reading_beside():
     from acting_default import NetworkReading
-    from bar_averaged import Items, bar_rows, linear_growth, status
+    from bar_averaged import Items, bar_rows, compared, linear_growth, status
 
     assert status({"cartpole": True, "finger": True, "walker": True}) == "met"
+    # means that print alike at 4 digits get 6, so the order the status reads shows; the interval keeps 4
+    assert compared((0.004847, 0.004807, 0.00004, (-0.0006, 0.0008), 12, 12), 4) == (
+        "0.004847 vs 0.004807 (+0.0000 [-0.0006, +0.0008])"
+    )
+    assert compared((0.0117, 0.0112, 0.0005, (-0.0003, 0.0015), 12, 12), 4) == "0.0117 vs 0.0112 (+0.0005 [-0.0003, +0.0015])"
     assert status({"cartpole": False, "finger": False}) == "missed"
     assert status({"cartpole": True, "finger": False, "walker": False}) == "met on cartpole, missed on finger and walker"
     assert status({"cartpole": True, "finger": True, "walker": False}) == "met on cartpole and finger, missed on walker"

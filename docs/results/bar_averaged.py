@@ -230,9 +230,11 @@ def interval(difference: float, bounds: tuple[float, float], digits: int) -> str
 
 
 def compared(values: Means, digits: int) -> str:
-    """``final_means`` as ``ours vs theirs (difference [low, high])``."""
+    """``final_means`` as ``ours vs theirs (difference [low, high])``; two means that differ but print alike at
+    ``digits`` get two more digits, so the order the status reads stays visible (``0.004847 vs 0.004807``)."""
     ours, theirs, difference, bounds, _, _ = values
-    return f"{ours:.{digits}f} vs {theirs:.{digits}f} ({interval(difference, bounds, digits)})"
+    shown = digits + 2 if ours != theirs and f"{ours:.{digits}f}" == f"{theirs:.{digits}f}" else digits
+    return f"{ours:.{shown}f} vs {theirs:.{shown}f} ({interval(difference, bounds, digits)})"
 
 
 def markdown_table(
