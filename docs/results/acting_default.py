@@ -125,11 +125,11 @@ def final_lines(table: pd.DataFrame) -> list[str]:
     return lines
 
 
-def complete(table: pd.DataFrame, seeds: list[int] = SEEDS_FOR_VERDICT) -> bool:
-    """Whether both agents finished ``seeds`` (by default 0 and 1: D4 takes its verdict only then) on all three
-    tasks."""
+def complete(table: pd.DataFrame, seeds: list[int] = SEEDS_FOR_VERDICT, agents: list[str] = AGENTS) -> bool:
+    """Whether ``agents`` (by default both of D4's) finished ``seeds`` (by default 0 and 1: D4 takes its verdict only
+    then) on all three tasks."""
     done = set(map(tuple, table[table["network"] == "average"][["algo", "env", "seed"]].drop_duplicates().to_numpy()))
-    return all((agent, task, seed) in done for agent in AGENTS for task in TASKS for seed in seeds)
+    return all((agent, task, seed) in done for agent in agents for task in TASKS for seed in seeds)
 
 
 def verdict(readings: dict[tuple[str, str], NetworkReading], is_complete: bool) -> str:

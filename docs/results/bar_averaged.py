@@ -319,10 +319,7 @@ def linear_probe_rows(folder: Path = LINEAR_FOLDER) -> pd.DataFrame | None:
 
 def linear_complete(linear_probe: pd.DataFrame | None) -> bool:
     """Whether gqn-linear finished ``LINEAR_SEEDS`` on all three tasks (D6's outcome waits for it)."""
-    if linear_probe is None:
-        return False
-    done = set(map(tuple, linear_probe[linear_probe["network"] == "average"][["env", "seed"]].drop_duplicates().to_numpy()))
-    return all((task, seed) in done for task in TASKS for seed in LINEAR_SEEDS)
+    return linear_probe is not None and complete_on(linear_probe, LINEAR_SEEDS, ["gqn-linear"])
 
 
 def held(reading: NetworkReading) -> str:
