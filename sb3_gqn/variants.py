@@ -75,6 +75,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "decqn-9+avg0.005": ("decqn", {"bins": 9, "acting_tau": 0.005}),
     "decqn-9+avg0.001": ("decqn", {"bins": 9, "acting_tau": 0.001}),
     "gqn-linear+avg0.001": ("gqn", {"growth": "linear", "acting_tau": 0.001}),
+    "decqn-2+avg0.001": ("decqn", {"bins": 2, "acting_tau": 0.001}),
     "gqn-adaptive+online": ("gqn", {"growth": "adaptive", "acting_tau": None}),
     "decqn-9+online": ("decqn", {"bins": 9, "acting_tau": None}),
 }
