@@ -1027,7 +1027,7 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
 
 def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run(tmp_path: Path):
     from acting_default import TASKS
-    from bar_averaged import LINEAR_SEEDS, linear_complete, linear_part, linear_probe_rows
+    from bar_averaged import LINEAR_SEEDS, finished_rows, linear_complete, linear_part
 
     def rows(algo: str, env: str, seed: int, returns: list[float]) -> pd.DataFrame:
         # one growth to 3 bins at 15k, between the evaluations at 10k and 20k
@@ -1048,14 +1048,14 @@ def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run
     cartpole = TASKS[0]
     # the tables' recorded gqn-linear run: 400 -> 250 fails (62 % < 70 %)
     tables = rows("gqn-linear", cartpole, 0, [400.0, 250.0])
-    assert linear_probe_rows(tmp_path / "none") is None and not linear_complete(None)
+    assert finished_rows(tmp_path / "none") is None and not linear_complete(None)
     assert linear_part(tables, None) == ("gqn-linear (online, as recorded) 0 of 1", False)
 
     folder = tmp_path / "cartpole"
     (folder / "online").mkdir(parents=True)
     rows("gqn-linear+avg0.001", cartpole, 0, [400.0, 380.0]).to_csv(folder / "results.csv", index=False)
     rows("gqn-linear", cartpole, 0, [400.0, 200.0]).to_csv(folder / "online" / "a.csv", index=False)
-    partial = linear_probe_rows(tmp_path)
+    partial = finished_rows(tmp_path)
     assert partial is not None and len(partial) == 4 and not linear_complete(partial)
     # one run of 18: the bar keeps the recorded count
     assert linear_part(tables, partial) == ("gqn-linear (online, as recorded) 0 of 1", False)
@@ -1084,3 +1084,78 @@ def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run
     failing.loc[(failing["network"] == "average") & (failing["seed"] == 3) & (failing["step"] == 20_000), "return"] = 100.0
     text, holds = linear_part(tables, failing)
     assert not holds and text.startswith("gqn-linear on the average 15 of 18 scored events hold")
+
+
+def test_bar_averaged_reads_decqn2_in_the_iqm_once_rule_d7_has_every_run(tmp_path: Path):
+    from acting_default import TASKS
+    from bar_averaged import DECQN2_SEEDS, decqn2_complete, decqn2_lines, finished_rows, read_items
+
+    def rows(algo: str, env: str, seed: int, final: float) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "algo": algo,
+                "env": env,
+                "penalty": 0.1,
+                "seed": seed,
+                "step": [50_000, 100_000],
+                "return": [0.0, final],
+                "smoothness": [0.02, 0.01],
+                "active_bins": [9, 9] if algo.startswith("decqn-9") else [2, 2] if algo.startswith("decqn-2") else [3, 9],
+                "growth_events": "" if algo.startswith("decqn") else "20000:3 30000:5 40000:9",
+            }
+        )
+
+    # every task: gqn-adaptive ends at 1000 and decqn-9 at 0 (the normalization's ends), gqn-linear at 800, the
+    # tables' decqn-2 at 500, so normalized 1, 0, 0.8 and 0.5 on every run: IQMs 1.00, 0.00, 0.80, 0.50
+    finals = {"gqn-adaptive": 1000.0, "decqn-9": 0.0, "gqn-linear": 800.0, "decqn-2": 500.0}
+    tables = pd.concat(
+        [
+            *(rows(algo, task, seed, final) for algo, final in finals.items() for task in TASKS for seed in [0, 1]),
+            rows("sac", TASKS[2], 0, 300.0),  # item (4)'s baseline; outside the IQM's agents
+        ],
+        ignore_index=True,
+    )
+    # D5's probe: the same runs of gqn-adaptive and decqn-9 on both networks
+    probe = pd.concat(
+        [
+            rows(algo, task, seed, finals[algo]).assign(network=network)
+            for algo in ["gqn-adaptive", "decqn-9"]
+            for task in TASKS
+            for seed in [0, 1]
+            for network in ["average", "online"]
+        ],
+        ignore_index=True,
+    )
+    assert read_items(tables, probe, "average").iqm["decqn-2"] == pytest.approx(0.5)
+
+    # D7's first pair: decqn-2 seeds 0 and 1 on cartpole only, 250 on the average and 750 online
+    folder = tmp_path / "cartpole"
+    (folder / "online").mkdir(parents=True)
+    pd.concat([rows("decqn-2+avg0.001", TASKS[0], seed, 250.0) for seed in [0, 1]]).to_csv(folder / "results.csv", index=False)
+    for seed in [0, 1]:
+        rows("decqn-2", TASKS[0], seed, 750.0).to_csv(folder / "online" / f"decqn-2__seed{seed}.csv", index=False)
+    assert finished_rows(tmp_path / "none") is None
+    partial = finished_rows(tmp_path)
+    assert partial is not None and not decqn2_complete(partial) and not decqn2_complete(None)
+    lines = decqn2_lines(tables, probe, partial)
+    # seeds 0 and 1 of cartpole have table rows (500 there): both differ
+    assert lines[1] == "check: 2 probe runs have table rows; 2 of them differ"
+    # read on one task only: no IQM for decqn-2 yet (the tables' runs of the other tasks are not mixed in)
+    assert lines[-3].endswith("(decqn-2: not yet read on every task)") and lines[-1].startswith("D7: partial")
+
+    # every task and seed 0-7: 250 on the average (normalized 0.25), 750 online (0.75)
+    every = pd.concat(
+        [
+            rows("decqn-2", task, seed, final).assign(network=network)
+            for task in TASKS
+            for seed in DECQN2_SEEDS
+            for network, final in [("average", 250.0), ("online", 750.0)]
+        ],
+        ignore_index=True,
+    )
+    assert decqn2_complete(every) and not decqn2_complete(every[every["seed"] != 7])
+    assert read_items(tables, probe, "average", every).iqm["decqn-2"] == pytest.approx(0.25)
+    assert read_items(tables, probe, "online", every).iqm["decqn-2"] == pytest.approx(0.75)
+    # gqn-adaptive's and decqn-9's IQM are the probe's either way
+    assert read_items(tables, probe, "average", every).iqm["gqn-adaptive"] == pytest.approx(1.0)
+    assert decqn2_lines(tables, probe, every)[-1].startswith("D7: complete")

@@ -17,6 +17,11 @@ gqn-linear's part of the collapse item (rule D6): its runs in ``probes/bar_avera
 seeds, same probe) are checked against the tables and read on both networks; until all 18 have finished, the bar's
 row keeps gqn-linear's count as the tables recorded it (online).
 
+decqn-2's part of the IQM item (rule D7): its runs in ``probes/bar_averaged_decqn2/`` (the IQM item's seeds 0-7, same
+probe) are checked against the tables' seeds 0 and 1 and read on both networks; once all 24 have finished they
+replace the tables' decqn-2 in the IQM of both readings (``--bar``, ``--markdown``); before that, decqn-2's IQM over
+the seeds read so far is reported as partial and the bar keeps the tables' decqn-2.
+
     .venv/bin/python docs/results/bar_averaged.py [--markdown | --bar]
 """
 
@@ -42,6 +47,9 @@ SEEDS_FOR_OUTCOME = list(range(12))
 #: rule D6: gqn-linear read on the average, on the tables' seeds of gqn-linear
 LINEAR_FOLDER = RESULTS / "probes" / "bar_averaged_linear"
 LINEAR_SEEDS = list(range(6))
+#: rule D7: decqn-2 read on the average, on the IQM item's seeds
+DECQN2_FOLDER = RESULTS / "probes" / "bar_averaged_decqn2"
+DECQN2_SEEDS = list(range(IQM_RUNS))
 WALKER = "dm_control/walker-walk-v0"
 #: what the check compares at every evaluation, and how closely
 CHECKED = ["return", "smoothness", "active_bins"]
@@ -91,10 +99,11 @@ def determinism_mismatches(probe: pd.DataFrame, tables: pd.DataFrame) -> tuple[i
 
 
 def with_network(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> pd.DataFrame:
-    """The tables' main agents and SAC with the runs of ``AGENTS`` replaced by ``probe``'s rows on ``network`` (only
-    the seeds the probe read: the agents' other seeds are left out, the other agents' runs kept)."""
-    others = tables[~tables["algo"].isin(AGENTS)]
+    """The tables' main agents and SAC with the runs of every agent ``probe`` holds (D5's ``AGENTS``, D7's decqn-2)
+    replaced by ``probe``'s rows on ``network`` (only the seeds the probe read: those agents' other seeds are left out,
+    the other agents' runs kept)."""
     read = probe[probe["network"] == network].drop(columns="network")
+    others = tables[~tables["algo"].isin(set(read["algo"]))]
     return pd.concat([others, read], ignore_index=True)
 
 
@@ -153,9 +162,10 @@ class Items:
     static: NetworkReading | None = None
 
 
-def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> Items:
-    """Items (1)-(4) on ``network``: the probe's runs of ``AGENTS`` in place of the tables' (``with_network``)."""
-    table = with_network(tables, probe, network)
+def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str, decqn2: pd.DataFrame | None = None) -> Items:
+    """Items (1)-(4) on ``network``: the probe's runs of ``AGENTS`` in place of the tables' (``with_network``), and
+    with ``decqn2`` (D7's runs) decqn-2's too."""
+    table = with_network(tables, probe if decqn2 is None else pd.concat([probe, decqn2], ignore_index=True), network)
     estimates, difference, interval = iqm_item(table)
     return Items(
         network,
@@ -238,10 +248,15 @@ def compared(values: Means, digits: int) -> str:
 
 
 def markdown_table(
-    probe: pd.DataFrame, online: Items, average: Items, linear: tuple[NetworkReading, NetworkReading] | None = None
+    probe: pd.DataFrame,
+    online: Items,
+    average: Items,
+    linear: tuple[NetworkReading, NetworkReading] | None = None,
+    decqn2_read: bool = False,
 ) -> list[str]:
     """The results report's D5 table: one row per item, the online reading beside the average's; with ``linear``
-    (gqn-linear's D6 readings, online and average), a row for its growth events under the collapse item's."""
+    (gqn-linear's D6 readings, online and average), a row for its growth events under the collapse item's;
+    ``decqn2_read``: the IQM reads D7's decqn-2 runs (the row says whose runs it reads)."""
 
     def failures(pairs: int, failed: list[str]) -> str:
         return f"{len(failed)} of {pairs}" + (f" ({'; '.join(failed)})" if failed else "")
@@ -282,7 +297,8 @@ def markdown_table(
             else []
         ),
         (
-            "IQM of normalized final return, gqn-adaptive vs decqn-9 (decqn-2, gqn-linear: the tables')",
+            "IQM of normalized final return, gqn-adaptive vs decqn-9 "
+            + ("(decqn-2: rule D7's runs; gqn-linear: the tables')" if decqn2_read else "(decqn-2, gqn-linear: the tables')"),
             iqm(online),
             iqm(average),
         ),
@@ -312,9 +328,47 @@ def linear_growth(tables: pd.DataFrame) -> tuple[int, int]:
     return sum(bool(check.held) for check in scored), len(scored)
 
 
-def linear_probe_rows(folder: Path = LINEAR_FOLDER) -> pd.DataFrame | None:
-    """D6's runs of gqn-linear, paired as D4's (``probe_rows``); ``None`` before any has finished."""
+def finished_rows(folder: Path) -> pd.DataFrame | None:
+    """One rule's runs in ``folder`` (D6's gqn-linear, D7's decqn-2), paired as D4's (``probe_rows``); ``None`` before
+    any has finished."""
     return probe_rows([folder]) if any(folder.glob("*/results.csv")) else None
+
+
+def decqn2_complete(decqn2_probe: pd.DataFrame | None) -> bool:
+    """Whether decqn-2 finished ``DECQN2_SEEDS`` on all three tasks (D7's outcome waits for it)."""
+    return decqn2_probe is not None and complete_on(decqn2_probe, DECQN2_SEEDS, ["decqn-2"])
+
+
+def decqn2_lines(tables: pd.DataFrame, probe: pd.DataFrame, decqn2_probe: pd.DataFrame) -> list[str]:
+    """D7's report: the check against the tables, the runs read, each run's final return and SM, and decqn-2's IQM
+    on both networks with its runs in place of the tables' (partial until ``decqn2_complete``)."""
+    compared, mismatches = determinism_mismatches(decqn2_probe, tables)
+    lines = [
+        "--- decqn-2 (rule D7)",
+        f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ",
+        *(f"    {line}" for line in mismatches),
+    ]
+    read = decqn2_probe[decqn2_probe["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
+    lines += [f"runs read: {str(env).split('/')[-1]:18s} decqn-2       seeds {seeds}" for env, seeds in read.items()]
+    lines += [f"    {line}" for line in final_lines(decqn2_probe)]
+    for network in ["online", "average"]:
+        iqm = read_items(tables, probe, network, decqn2_probe).iqm
+        # an agent without a run on every task has no IQM (``equal_run_scores``)
+        missing = "" if "decqn-2" in iqm else " (decqn-2: not yet read on every task)"
+        lines.append(
+            f"{network}: IQM with these decqn-2 runs: "
+            + ", ".join(f"{algo} {value:.2f}" for algo, value in sorted(iqm.items()))
+            + missing
+        )
+    state = (
+        "complete: the bar's IQM row reads decqn-2 from these runs"
+        if decqn2_complete(decqn2_probe)
+        else (
+            f"partial (D7 waits for decqn-2's seeds {DECQN2_SEEDS[0]}-{DECQN2_SEEDS[-1]} on all three tasks; the bar keeps "
+            "the tables' decqn-2)"
+        )
+    )
+    return [*lines, f"D7: {state}"]
 
 
 def linear_complete(linear_probe: pd.DataFrame | None) -> bool:
@@ -397,6 +451,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--folders", type=Path, nargs="+", default=FOLDERS, help="probe folders, one subfolder per task")
     parser.add_argument("--linear-folder", type=Path, default=LINEAR_FOLDER, help="D6's folder of gqn-linear runs")
+    parser.add_argument("--decqn2-folder", type=Path, default=DECQN2_FOLDER, help="D7's folder of decqn-2 runs")
     printed = parser.add_mutually_exclusive_group()
     printed.add_argument("--markdown", action="store_true", help="print the items as the results report's table")
     printed.add_argument("--bar", action="store_true", help="print the README bar table's rows (D5 complete only)")
@@ -404,15 +459,18 @@ def main(argv: list[str] | None = None) -> int:
     probe = probe_rows(args.folders)
     tables = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
     tables = tables[tables["algo"].isin([*MAIN_ALGOS, "sac"])]
-    online, average = (read_items(tables, probe, network) for network in ["online", "average"])
-    linear_probe = linear_probe_rows(args.linear_folder)
+    decqn2_probe = finished_rows(args.decqn2_folder)
+    # the IQM reads D7's decqn-2 runs only once they are all in (rule D7)
+    decqn2 = decqn2_probe if decqn2_complete(decqn2_probe) else None
+    online, average = (read_items(tables, probe, network, decqn2) for network in ["online", "average"])
+    linear_probe = finished_rows(args.linear_folder)
     linear = (
         None
         if linear_probe is None
         else tuple(read_network(linear_probe, "gqn-linear", network, start=30_000) for network in ["online", "average"])
     )
     if args.markdown:
-        print("\n".join(markdown_table(probe, online, average, linear)))  # type: ignore[arg-type]
+        print("\n".join(markdown_table(probe, online, average, linear, decqn2 is not None)))  # type: ignore[arg-type]
         return 0
     if args.bar:
         if not complete(probe):
@@ -458,6 +516,8 @@ def main(argv: list[str] | None = None) -> int:
         else ("partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)")
     )
     print(f"D6: {linear_state}")
+    if decqn2_probe is not None:
+        print("\n".join(decqn2_lines(tables, probe, decqn2_probe)))
     return 0
 
 
