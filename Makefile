@@ -13,7 +13,7 @@ $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 
 venv: $(VENV)/.installed
 
-# Main job (~10 min on 2 cores): GQN on penalized cartpole-swingup (learning curve, final evaluation), then the
+# Main job (~7-10 min on 2 cores): GQN on penalized cartpole-swingup (learning curve, final evaluation), then the
 # short comparison suite (GQN vs DecQN 2/9 vs SAC on penalized Pendulum: table and plots) into results/
 results: venv
 	$(BIN)/python -m sb3_gqn.reference_run --out results --timesteps 50000
