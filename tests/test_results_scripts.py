@@ -1159,3 +1159,15 @@ def test_bar_averaged_reads_decqn2_in_the_iqm_once_rule_d7_has_every_run(tmp_pat
     # gqn-adaptive's and decqn-9's IQM are the probe's either way
     assert read_items(tables, probe, "average", every).iqm["gqn-adaptive"] == pytest.approx(1.0)
     assert decqn2_lines(tables, probe, every)[-1].startswith("D7: complete")
+
+
+def test_noise_floor_is_the_static_rate_to_the_events_power_and_fishers_exact_test():
+    from bar_averaged import noise_floor
+
+    # a static agent failing 1 of 4 pairs: 2 events all hold with probability 0.75^2 = 0.5625; the 2x2 table
+    # [[0, 2], [1, 3]] is as likely as any other with its margins, so Fisher's two-sided p is 1
+    assert noise_floor(0, 2, 1, 4) == (pytest.approx(0.5625), pytest.approx(1.0))
+    # 3 of 3 events failing against 0 of 3 pairs: p = 1 / C(6, 3) for each extreme table, two-sided 2 / 20 = 0.1
+    assert noise_floor(3, 3, 0, 3)[1] == pytest.approx(0.1)
+    # no static failure: every event holds for sure at that rate
+    assert noise_floor(1, 5, 0, 10)[0] == 1.0

@@ -396,6 +396,17 @@ def linear_part(tables: pd.DataFrame, linear_probe: pd.DataFrame | None) -> tupl
     return f"gqn-linear (online, as recorded) {linear_held} of {linear_scored}", linear_held == linear_scored
 
 
+def noise_floor(failed: int, events: int, static_failed: int, static_pairs: int) -> tuple[float, float]:
+    """Not pre-stated (the collapse item's scale): the probability that ``events`` growth events all hold if each
+    fails at a static agent's rate between consecutive evaluations (``static_failed`` of ``static_pairs``), treating
+    them as independent, and Fisher's exact test (two-sided) of ``failed`` of ``events`` against that rate."""
+    from scipy.stats import fisher_exact
+
+    all_hold = (1.0 - static_failed / static_pairs) ** events
+    table = [[failed, events - failed], [static_failed, static_pairs - static_failed]]
+    return float(all_hold), float(fisher_exact(table).pvalue)
+
+
 def joined(names: list[str]) -> str:
     """``["a", "b", "c"]`` -> ``a, b and c``."""
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
@@ -516,6 +527,16 @@ def main(argv: list[str] | None = None) -> int:
         else ("partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)")
     )
     print(f"D6: {linear_state}")
+    if linear is not None and average.static is not None:
+        failed = len(average.growth.growth_failed) + len(linear[1].growth_failed)
+        events = average.growth.growth_pairs + linear[1].growth_pairs
+        static = average.static
+        all_hold, fisher = noise_floor(failed, events, len(static.late_failed), static.late_pairs)
+        print(
+            f"scale (not pre-stated), on the average: both GQN schedules fail {failed} of {events} growth events, "
+            f"decqn-9 {len(static.late_failed)} of {static.late_pairs} consecutive pairs from 30k; at decqn-9's rate "
+            f"all {events} events hold with probability {all_hold:.2f}; Fisher's exact test p = {fisher:.2f}"
+        )
     if decqn2_probe is not None:
         print("\n".join(decqn2_lines(tables, probe, decqn2_probe)))
     return 0
