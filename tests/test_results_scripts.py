@@ -16,6 +16,31 @@ from bin_interpolation import growth_step_errors, quadratic_weights
 from smoothness_at_matched_return import bootstrap_interval, matched_difference
 
 
+def runner_rows(
+    algo: str,
+    env: str,
+    seed: int,
+    steps: list[int],
+    returns: list[float],
+    smoothness: list[float],
+    growth_events: str = "",
+    active_bins: list[int] | None = None,
+) -> pd.DataFrame:
+    """One run's evaluations in the runner's ``results.csv`` columns that the scripts read (c = 0.1)."""
+    columns = {
+        "algo": algo,
+        "env": env,
+        "penalty": 0.1,
+        "seed": seed,
+        "step": steps,
+        "return": returns,
+        "smoothness": smoothness,
+    }
+    if active_bins is not None:
+        columns["active_bins"] = active_bins
+    return pd.DataFrame({**columns, "growth_events": growth_events})
+
+
 def test_quadratic_weights_are_the_lagrange_weights_of_the_nearest_three_coarse_bins():
     # Bin 2 (a = -0.5) from bins 0, 4, 8 (a = -1, 0, 1): (x)(x - 1) / 2 = 3/8, (x + 1)(x - 1) / -1 = 3/4,
     # (x + 1)(x) / 2 = -1/8
@@ -691,18 +716,7 @@ def test_acting_default_reads_both_networks_on_the_same_evaluations(tmp_path: Pa
     cartpole = "dm_control/cartpole-swingup-v0"
 
     def rows(algo: str, seed: int, returns: list[float], sms: list[float], events: str) -> pd.DataFrame:
-        return pd.DataFrame(
-            {
-                "algo": algo,
-                "env": cartpole,
-                "penalty": 0.1,
-                "seed": seed,
-                "step": steps,
-                "return": returns,
-                "smoothness": sms,
-                "growth_events": events,
-            }
-        )
+        return runner_rows(algo, cartpole, seed, steps, returns, sms, events)
 
     folder = tmp_path / "cartpole"
     (folder / "online").mkdir(parents=True)
@@ -783,19 +797,7 @@ def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on
     walker = "dm_control/walker-walk-v0"
 
     def rows(algo: str, seed: int, returns: list[float], sms: list[float], bins: list[int]) -> pd.DataFrame:
-        return pd.DataFrame(
-            {
-                "algo": algo,
-                "env": walker,
-                "penalty": 0.1,
-                "seed": seed,
-                "step": [10_000, 20_000],
-                "return": returns,
-                "smoothness": sms,
-                "active_bins": bins,
-                "growth_events": "",
-            }
-        )
+        return runner_rows(algo, walker, seed, [10_000, 20_000], returns, sms, active_bins=bins)
 
     folder = tmp_path / "d5" / "walker"
     (folder / "online").mkdir(parents=True)
@@ -1031,19 +1033,7 @@ def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run
 
     def rows(algo: str, env: str, seed: int, returns: list[float]) -> pd.DataFrame:
         # one growth to 3 bins at 15k, between the evaluations at 10k and 20k
-        return pd.DataFrame(
-            {
-                "algo": algo,
-                "env": env,
-                "penalty": 0.1,
-                "seed": seed,
-                "step": [10_000, 20_000],
-                "return": returns,
-                "smoothness": [0.02, 0.01],
-                "active_bins": [2, 3],
-                "growth_events": "15000:3",
-            }
-        )
+        return runner_rows(algo, env, seed, [10_000, 20_000], returns, [0.02, 0.01], "15000:3", [2, 3])
 
     cartpole = TASKS[0]
     # the tables' recorded gqn-linear run: 400 -> 250 fails (62 % < 70 %)
@@ -1091,19 +1081,9 @@ def test_bar_averaged_reads_decqn2_in_the_iqm_once_rule_d7_has_every_run(tmp_pat
     from bar_averaged import DECQN2_SEEDS, decqn2_complete, decqn2_lines, finished_rows, read_items
 
     def rows(algo: str, env: str, seed: int, final: float) -> pd.DataFrame:
-        return pd.DataFrame(
-            {
-                "algo": algo,
-                "env": env,
-                "penalty": 0.1,
-                "seed": seed,
-                "step": [50_000, 100_000],
-                "return": [0.0, final],
-                "smoothness": [0.02, 0.01],
-                "active_bins": [9, 9] if algo.startswith("decqn-9") else [2, 2] if algo.startswith("decqn-2") else [3, 9],
-                "growth_events": "" if algo.startswith("decqn") else "20000:3 30000:5 40000:9",
-            }
-        )
+        bins = [9, 9] if algo.startswith("decqn-9") else [2, 2] if algo.startswith("decqn-2") else [3, 9]
+        events = "" if algo.startswith("decqn") else "20000:3 30000:5 40000:9"
+        return runner_rows(algo, env, seed, [50_000, 100_000], [0.0, final], [0.02, 0.01], events, bins)
 
     # every task: gqn-adaptive ends at 1000 and decqn-9 at 0 (the normalization's ends), gqn-linear at 800, the
     # tables' decqn-2 at 500, so normalized 1, 0, 0.8 and 0.5 on every run: IQMs 1.00, 0.00, 0.80, 0.50

@@ -339,18 +339,24 @@ def decqn2_complete(decqn2_probe: pd.DataFrame | None) -> bool:
     return decqn2_probe is not None and complete_on(decqn2_probe, DECQN2_SEEDS, ["decqn-2"])
 
 
-def decqn2_lines(tables: pd.DataFrame, probe: pd.DataFrame, decqn2_probe: pd.DataFrame) -> list[str]:
-    """D7's report: the check against the tables, the runs read, each run's final return and SM, and decqn-2's IQM
-    on both networks with its runs in place of the tables' (partial until ``decqn2_complete``)."""
-    compared, mismatches = determinism_mismatches(decqn2_probe, tables)
-    lines = [
-        "--- decqn-2 (rule D7)",
+def rerun_lines(rule: str, agent: str, rerun: pd.DataFrame, tables: pd.DataFrame) -> list[str]:
+    """A rerun rule's (D6's, D7's) first report lines for its one agent: the check against the tables, the seeds
+    read per task, and each run's final return and SM on both networks."""
+    compared, mismatches = determinism_mismatches(rerun, tables)
+    read = rerun[rerun["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
+    return [
+        f"--- {agent} (rule {rule})",
         f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ",
         *(f"    {line}" for line in mismatches),
+        *(f"runs read: {str(env).split('/')[-1]:18s} {agent:13s} seeds {seeds}" for env, seeds in read.items()),
+        *(f"    {line}" for line in final_lines(rerun)),
     ]
-    read = decqn2_probe[decqn2_probe["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
-    lines += [f"runs read: {str(env).split('/')[-1]:18s} decqn-2       seeds {seeds}" for env, seeds in read.items()]
-    lines += [f"    {line}" for line in final_lines(decqn2_probe)]
+
+
+def decqn2_lines(tables: pd.DataFrame, probe: pd.DataFrame, decqn2_probe: pd.DataFrame) -> list[str]:
+    """D7's report: ``rerun_lines``, then decqn-2's IQM on both networks with its runs in place of the tables'
+    (partial until ``decqn2_complete``)."""
+    lines = rerun_lines("D7", "decqn-2", decqn2_probe, tables)
     for network in ["online", "average"]:
         iqm = read_items(tables, probe, network, decqn2_probe).iqm
         # an agent without a run on every task has no IQM (``equal_run_scores``)
@@ -504,15 +510,7 @@ def main(argv: list[str] | None = None) -> int:
     state = "complete: the bar's items above are D5's outcome" if complete(probe) else "partial (D5 waits for seeds 0-11)"
     print(f"D5: {state}")
     if linear_probe is not None and linear is not None:
-        compared, mismatches = determinism_mismatches(linear_probe, tables)
-        print(f"--- gqn-linear (rule D6)\ncheck: {compared} probe runs have table rows; {len(mismatches)} of them differ")
-        for line in mismatches:
-            print(f"    {line}")
-        read = linear_probe[linear_probe["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
-        for env, seeds_read in read.items():
-            print(f"runs read: {str(env).split('/')[-1]:18s} gqn-linear    seeds {seeds_read}")
-        for line in final_lines(linear_probe):
-            print(f"    {line}")
+        print("\n".join(rerun_lines("D6", "gqn-linear", linear_probe, tables)))
         for reading in linear:
             print(
                 f"{reading.network}: growth events failed {len(reading.growth_failed)} of {reading.growth_pairs}; pairs "
