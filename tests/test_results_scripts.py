@@ -784,7 +784,7 @@ def test_acting_default_reads_both_networks_on_the_same_evaluations(tmp_path: Pa
 
 def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on_one_network(tmp_path: Path):
     from acting_default import AGENTS, TASKS
-    from bar_averaged import (
+    from bar_items import (
         SEEDS_FOR_OUTCOME,
         complete,
         determinism_mismatches,
@@ -858,7 +858,8 @@ def test_bar_averaged_checks_the_probe_against_the_tables_and_reads_each_item_on
 
 def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row():
     from acting_default import NetworkReading
-    from bar_averaged import Items, markdown_table, seed_ranges
+    from bar_averaged import markdown_table, seed_ranges
+    from bar_items import Items
 
     cartpole, finger, walker = (f"dm_control/{task}-v0" for task in ["cartpole-swingup", "finger-spin", "walker-walk"])
     probe = pd.DataFrame(
@@ -932,7 +933,9 @@ def test_bar_averaged_markdown_table_puts_each_item_of_both_networks_on_one_row(
 
 def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_reading_beside():
     from acting_default import NetworkReading
-    from bar_averaged import Items, bar_rows, compared, linear_growth, status
+    from bar_averaged import bar_rows, compared, status
+    from bar_items import Items
+    from bar_reruns import linear_growth
 
     assert status({"cartpole": True, "finger": True, "walker": True}) == "met"
     # means that print alike at 4 digits get 6, so the order the status reads shows; the interval keeps 4
@@ -1029,7 +1032,8 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
 
 def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run(tmp_path: Path):
     from acting_default import TASKS
-    from bar_averaged import LINEAR_SEEDS, finished_rows, linear_complete, linear_part
+    from bar_items import finished_rows
+    from bar_reruns import LINEAR_SEEDS, linear_complete, linear_part
 
     def rows(algo: str, env: str, seed: int, returns: list[float]) -> pd.DataFrame:
         # one growth to 3 bins at 15k, between the evaluations at 10k and 20k
@@ -1078,7 +1082,8 @@ def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run
 
 def test_bar_averaged_reads_decqn2_in_the_iqm_once_rule_d7_has_every_run(tmp_path: Path):
     from acting_default import TASKS
-    from bar_averaged import DECQN2_SEEDS, decqn2_complete, decqn2_lines, finished_rows, read_items
+    from bar_items import finished_rows, read_items
+    from bar_reruns import DECQN2_SEEDS, decqn2_complete, decqn2_lines
 
     def rows(algo: str, env: str, seed: int, final: float) -> pd.DataFrame:
         bins = [9, 9] if algo.startswith("decqn-9") else [2, 2] if algo.startswith("decqn-2") else [3, 9]
@@ -1142,7 +1147,7 @@ def test_bar_averaged_reads_decqn2_in_the_iqm_once_rule_d7_has_every_run(tmp_pat
 
 
 def test_noise_floor_is_the_static_rate_to_the_events_power_and_fishers_exact_test():
-    from bar_averaged import noise_floor
+    from bar_reruns import noise_floor
 
     # a static agent failing 1 of 4 pairs: 2 events all hold with probability 0.75^2 = 0.5625; the 2x2 table
     # [[0, 2], [1, 3]] is as likely as any other with its margins, so Fisher's two-sided p is 1

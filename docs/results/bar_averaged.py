@@ -22,6 +22,9 @@ probe) are checked against the tables' seeds 0 and 1 and read on both networks; 
 replace the tables' decqn-2 in the IQM of both readings (``--bar``, ``--markdown``); before that, decqn-2's IQM over
 the seeds read so far is reported as partial and the bar keeps the tables' decqn-2.
 
+This module prints the report; ``bar_items.py`` reads the items on one network, ``bar_reruns.py`` holds D6's and
+D7's parts and the collapse item's noise floor.
+
     .venv/bin/python docs/results/bar_averaged.py [--markdown | --bar]
 """
 
@@ -29,154 +32,25 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from acting_default import AGENTS, TASKS, NetworkReading, final_lines, paired_table, read_network
-from acting_default import complete as complete_on
+from acting_default import AGENTS, TASKS, NetworkReading, final_lines, read_network
+from bar_items import FOLDERS, RESULTS, Items, Means, complete, determinism_mismatches, finished_rows, probe_rows, read_items
+from bar_reruns import (
+    DECQN2_FOLDER,
+    LINEAR_FOLDER,
+    decqn2_complete,
+    decqn2_lines,
+    held,
+    linear_complete,
+    linear_part,
+    noise_floor,
+    rerun_lines,
+)
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
-from sb3_gqn.plots import final_rows, iqm_with_intervals, normalized_final_scores
-from sb3_gqn.report import growth_checks, load
-from sb3_gqn.significance import difference_interval, iqm_difference, mean_difference
-
-RESULTS = Path(__file__).resolve().parent
-FOLDERS = [RESULTS / "probes" / "acting_default", RESULTS / "probes" / "bar_averaged"]
-SEEDS_FOR_OUTCOME = list(range(12))
-#: rule D6: gqn-linear read on the average, on the tables' seeds of gqn-linear
-LINEAR_FOLDER = RESULTS / "probes" / "bar_averaged_linear"
-LINEAR_SEEDS = list(range(6))
-#: rule D7: decqn-2 read on the average, on the IQM item's seeds
-DECQN2_FOLDER = RESULTS / "probes" / "bar_averaged_decqn2"
-DECQN2_SEEDS = list(range(IQM_RUNS))
-WALKER = "dm_control/walker-walk-v0"
-#: what the check compares at every evaluation, and how closely
-CHECKED = ["return", "smoothness", "active_bins"]
-TOLERANCE = 1e-6
-#: ``final_means``: mean of the first agent, of the second, the difference, its 95 % interval, the runs of each
-Means = tuple[float, float, float, tuple[float, float], int, int]
-
-
-def probe_rows(folders: list[Path]) -> pd.DataFrame:
-    """D4's ``paired_table`` of every folder that holds finished runs, concatenated."""
-    tables = [paired_table(folder) for folder in folders if any(folder.glob("*/results.csv"))]
-    if not tables:
-        raise FileNotFoundError(f"no finished runs under {[str(folder) for folder in folders]}")
-    return pd.concat(tables, ignore_index=True)
-
-
-def determinism_mismatches(probe: pd.DataFrame, tables: pd.DataFrame) -> tuple[int, list[str]]:
-    """How many of ``probe``'s online runs have rows in ``tables`` (same agent, task, seed), and a line for each such
-    run with evaluations whose return, SM or active bins differ from the tables' by more than ``TOLERANCE`` or that
-    only one side holds: how many of its evaluations differ, and the first."""
-    online = probe[probe["network"] == "online"]
-    compared, mismatches = 0, []
-    for (algo, env, seed), run in online.groupby(["algo", "env", "seed"]):
-        recorded = tables[(tables["algo"] == algo) & (tables["env"] == env) & (tables["seed"] == seed)]
-        if recorded.empty:
-            continue
-        compared += 1
-        merged = run.merge(recorded, on="step", how="outer", suffixes=("", "_table"), indicator=True).sort_values("step")
-        differing = []
-        for _, row in merged.iterrows():
-            if row["_merge"] != "both":
-                differing.append(f"{row['step']} only in the {'probe' if row['_merge'] == 'left_only' else 'table'}")
-                continue
-            columns = [
-                f"{column} {row[column]:.6g} vs {row[column + '_table']:.6g}"
-                for column in CHECKED
-                if not abs(float(row[column]) - float(row[column + "_table"])) <= TOLERANCE
-            ]
-            if columns:
-                differing.append(f"{row['step']}: " + ", ".join(columns))
-        if differing:
-            mismatches.append(
-                f"{str(env).split('/')[-1]} {algo} seed {seed}: {len(differing)} of {len(merged)} evaluations differ "
-                f"(probe vs table), first at {differing[0]}"
-            )
-    return compared, mismatches
-
-
-def with_network(tables: pd.DataFrame, probe: pd.DataFrame, network: str) -> pd.DataFrame:
-    """The tables' main agents and SAC with the runs of every agent ``probe`` holds (D5's ``AGENTS``, D7's decqn-2)
-    replaced by ``probe``'s rows on ``network`` (only the seeds the probe read: those agents' other seeds are left out,
-    the other agents' runs kept)."""
-    read = probe[probe["network"] == network].drop(columns="network")
-    others = tables[~tables["algo"].isin(set(read["algo"]))]
-    return pd.concat([others, read], ignore_index=True)
-
-
-def iqm_item(table: pd.DataFrame) -> tuple[dict[str, float], float, tuple[float, float]]:
-    """IQM of normalized final return per main agent on each agent's lowest ``IQM_RUNS`` seeds (normalized over every
-    run of the main agents, as the bar's table), and IQM(gqn-adaptive) - IQM(decqn-9) with its 95 % interval."""
-    main = table[table["algo"].isin(MAIN_ALGOS)]
-    scores, _ = normalized_final_scores(main, IQM_RUNS)
-    estimates, _ = iqm_with_intervals(scores)
-    difference, interval = difference_interval(iqm_difference, scores["gqn-adaptive"], scores["decqn-9"], 2000)
-    return {algo: float(value[0]) for algo, value in estimates.items()}, difference, interval
-
-
-def final_means(table: pd.DataFrame, env: str, column: str, first: str, second: str) -> Means:
-    """Mean final ``column`` on ``env`` of agent ``first`` and of ``second``, the difference with its 95 % interval,
-    and the runs of each."""
-    final = final_rows(table[table["env"] == env])
-    values_first = final[final["algo"] == first][column].to_numpy()
-    values_second = final[final["algo"] == second][column].to_numpy()
-    difference, interval = difference_interval(mean_difference, values_first, values_second, 2000)
-    return float(values_first.mean()), float(values_second.mean()), difference, interval, len(values_first), len(values_second)
-
-
-def sm_item(table: pd.DataFrame, env: str) -> Means:
-    """Mean final SM of gqn-adaptive and of decqn-9 on ``env``, their difference with its 95 % interval, and the runs
-    of each."""
-    return final_means(table, env, "smoothness", "gqn-adaptive", "decqn-9")
-
-
-def walker_item(table: pd.DataFrame) -> Means:
-    """Mean final return on walker-walk of gqn-adaptive and of SAC, the difference with its 95 % interval, and the
-    runs of each."""
-    return final_means(table, WALKER, "return", "gqn-adaptive", "sac")
-
-
-def complete(probe: pd.DataFrame) -> bool:
-    """Whether both agents finished seeds 0-11 on all three tasks (D5's outcome waits for it)."""
-    return complete_on(probe, SEEDS_FOR_OUTCOME)
-
-
-@dataclass(frozen=True)
-class Items:
-    """The bar's items read on one network: (1) gqn-adaptive's growth events (and the late pairs, reported), (2) the
-    IQM per main agent with gqn-adaptive - decqn-9 and its interval, (3) ``final_means`` of SM per task, (4)
-    ``final_means`` of walker-walk's return against SAC."""
-
-    network: str
-    growth: NetworkReading
-    iqm: dict[str, float]
-    iqm_difference: float
-    iqm_interval: tuple[float, float]
-    sm: dict[str, Means]
-    walker: Means
-    #: for scale, not an item: decqn-9, which never grows, read as ``growth``'s late pairs (consecutive evaluations
-    #: from 30k that fail the collapse criterion with no growth between them)
-    static: NetworkReading | None = None
-
-
-def read_items(tables: pd.DataFrame, probe: pd.DataFrame, network: str, decqn2: pd.DataFrame | None = None) -> Items:
-    """Items (1)-(4) on ``network``: the probe's runs of ``AGENTS`` in place of the tables' (``with_network``), and
-    with ``decqn2`` (D7's runs) decqn-2's too."""
-    table = with_network(tables, probe if decqn2 is None else pd.concat([probe, decqn2], ignore_index=True), network)
-    estimates, difference, interval = iqm_item(table)
-    return Items(
-        network,
-        read_network(probe, "gqn-adaptive", network, start=30_000),
-        estimates,
-        difference,
-        interval,
-        {env: sm_item(table, env) for env in TASKS},
-        walker_item(table),
-        read_network(probe, "decqn-9", network, start=30_000),
-    )
+from sb3_gqn.report import load
 
 
 def short(env: str) -> str:
@@ -321,98 +195,6 @@ def markdown_table(
     ]
 
 
-def linear_growth(tables: pd.DataFrame) -> tuple[int, int]:
-    """How many of gqn-linear's scored growth events in ``tables`` hold the collapse criterion, and how many there are
-    (a growth before the first evaluation is unscored, as in the bar)."""
-    scored = [check for check in growth_checks(tables[tables["algo"] == "gqn-linear"]) if check.held is not None]
-    return sum(bool(check.held) for check in scored), len(scored)
-
-
-def finished_rows(folder: Path) -> pd.DataFrame | None:
-    """One rule's runs in ``folder`` (D6's gqn-linear, D7's decqn-2), paired as D4's (``probe_rows``); ``None`` before
-    any has finished."""
-    return probe_rows([folder]) if any(folder.glob("*/results.csv")) else None
-
-
-def decqn2_complete(decqn2_probe: pd.DataFrame | None) -> bool:
-    """Whether decqn-2 finished ``DECQN2_SEEDS`` on all three tasks (D7's outcome waits for it)."""
-    return decqn2_probe is not None and complete_on(decqn2_probe, DECQN2_SEEDS, ["decqn-2"])
-
-
-def rerun_lines(rule: str, agent: str, rerun: pd.DataFrame, tables: pd.DataFrame) -> list[str]:
-    """A rerun rule's (D6's, D7's) first report lines for its one agent: the check against the tables, the seeds
-    read per task, and each run's final return and SM on both networks."""
-    compared, mismatches = determinism_mismatches(rerun, tables)
-    read = rerun[rerun["network"] == "average"].groupby("env")["seed"].agg(lambda s: sorted(set(s)))
-    return [
-        f"--- {agent} (rule {rule})",
-        f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ",
-        *(f"    {line}" for line in mismatches),
-        *(f"runs read: {str(env).split('/')[-1]:18s} {agent:13s} seeds {seeds}" for env, seeds in read.items()),
-        *(f"    {line}" for line in final_lines(rerun)),
-    ]
-
-
-def decqn2_lines(tables: pd.DataFrame, probe: pd.DataFrame, decqn2_probe: pd.DataFrame) -> list[str]:
-    """D7's report: ``rerun_lines``, then decqn-2's IQM on both networks with its runs in place of the tables'
-    (partial until ``decqn2_complete``)."""
-    lines = rerun_lines("D7", "decqn-2", decqn2_probe, tables)
-    for network in ["online", "average"]:
-        iqm = read_items(tables, probe, network, decqn2_probe).iqm
-        # an agent without a run on every task has no IQM (``equal_run_scores``)
-        missing = "" if "decqn-2" in iqm else " (decqn-2: not yet read on every task)"
-        lines.append(
-            f"{network}: IQM with these decqn-2 runs: "
-            + ", ".join(f"{algo} {value:.2f}" for algo, value in sorted(iqm.items()))
-            + missing
-        )
-    state = (
-        "complete: the bar's IQM row reads decqn-2 from these runs"
-        if decqn2_complete(decqn2_probe)
-        else (
-            f"partial (D7 waits for decqn-2's seeds {DECQN2_SEEDS[0]}-{DECQN2_SEEDS[-1]} on all three tasks; the bar keeps "
-            "the tables' decqn-2)"
-        )
-    )
-    return [*lines, f"D7: {state}"]
-
-
-def linear_complete(linear_probe: pd.DataFrame | None) -> bool:
-    """Whether gqn-linear finished ``LINEAR_SEEDS`` on all three tasks (D6's outcome waits for it)."""
-    return linear_probe is not None and complete_on(linear_probe, LINEAR_SEEDS, ["gqn-linear"])
-
-
-def held(reading: NetworkReading) -> str:
-    """``N of M scored events hold`` and the failed events."""
-    failed = reading.growth_failed
-    return f"{reading.growth_pairs - len(failed)} of {reading.growth_pairs} scored events hold" + (
-        f" ({'; '.join(failed)})" if failed else ""
-    )
-
-
-def linear_part(tables: pd.DataFrame, linear_probe: pd.DataFrame | None) -> tuple[str, bool]:
-    """gqn-linear's part of the bar's collapse row and whether it holds: once D6 is complete, its events on the average
-    with the online reading beside (the status reads the average); before that, the tables' online count."""
-    if linear_complete(linear_probe):
-        average, online = (
-            read_network(linear_probe, "gqn-linear", network, start=30_000) for network in ["average", "online"]
-        )
-        return f"gqn-linear on the average {held(average)}; online {held(online)}", not average.growth_failed
-    linear_held, linear_scored = linear_growth(tables)
-    return f"gqn-linear (online, as recorded) {linear_held} of {linear_scored}", linear_held == linear_scored
-
-
-def noise_floor(failed: int, events: int, static_failed: int, static_pairs: int) -> tuple[float, float]:
-    """Not pre-stated (the collapse item's scale): the probability that ``events`` growth events all hold if each
-    fails at a static agent's rate between consecutive evaluations (``static_failed`` of ``static_pairs``), treating
-    them as independent, and Fisher's exact test (two-sided) of ``failed`` of ``events`` against that rate."""
-    from scipy.stats import fisher_exact
-
-    all_hold = (1.0 - static_failed / static_pairs) ** events
-    table = [[failed, events - failed], [static_failed, static_pairs - static_failed]]
-    return float(all_hold), float(fisher_exact(table).pvalue)
-
-
 def joined(names: list[str]) -> str:
     """``["a", "b", "c"]`` -> ``a, b and c``."""
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
@@ -495,8 +277,8 @@ def main(argv: list[str] | None = None) -> int:
             return 1
         print("\n".join(bar_rows(average, online, linear_part(tables, linear_probe))))
         return 0
-    compared, mismatches = determinism_mismatches(probe, tables)
-    print(f"check: {compared} probe runs have table rows; {len(mismatches)} of them differ")
+    checked, mismatches = determinism_mismatches(probe, tables)
+    print(f"check: {checked} probe runs have table rows; {len(mismatches)} of them differ")
     for line in mismatches:
         print(f"    {line}")
     seeds = probe[probe["network"] == "average"].groupby(["env", "algo"])["seed"].agg(lambda s: sorted(set(s)))

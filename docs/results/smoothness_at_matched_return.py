@@ -15,7 +15,7 @@ together). ``explained`` is the share of the raw mean difference that the task-r
 (``1 - d / raw``). A diagnostic: the bar's item stays the raw comparison.
 
 ``--network average`` (or ``online``) reads D4's and D5's probe runs instead of the tables (rule D5,
-``decision_rules.md``; ``bar_averaged.probe_rows``): the same 12 runs a side per task, acting on the averaged network
+``decision_rules.md``; ``bar_items.probe_rows``): the same 12 runs a side per task, acting on the averaged network
 ``predict`` acts on by default, or on the online network of the same evaluations.
 
     .venv/bin/python docs/results/smoothness_at_matched_return.py
@@ -30,7 +30,7 @@ import sys
 
 import numpy as np
 import pandas as pd
-from bar_averaged import FOLDERS, probe_rows
+from bar_items import FOLDERS, probe_rows
 from readme_tables import MAIN_TABLES, RESULTS, shipped
 
 from sb3_gqn.plots import final_rows
