@@ -1033,7 +1033,7 @@ def test_bar_averaged_bar_rows_read_each_status_on_the_average_with_the_online_r
 def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run(tmp_path: Path):
     from acting_default import TASKS
     from bar_items import finished_rows
-    from bar_reruns import LINEAR_SEEDS, linear_complete, linear_part
+    from bar_reruns import LINEAR_SEEDS, linear_complete, linear_lines, linear_part
 
     def rows(algo: str, env: str, seed: int, returns: list[float]) -> pd.DataFrame:
         # one growth to 3 bins at 15k, between the evaluations at 10k and 20k
@@ -1044,6 +1044,10 @@ def test_bar_averaged_reads_gqn_linear_on_the_average_once_rule_d6_has_every_run
     tables = rows("gqn-linear", cartpole, 0, [400.0, 250.0])
     assert finished_rows(tmp_path / "none") is None and not linear_complete(None)
     assert linear_part(tables, None) == ("gqn-linear (online, as recorded) 0 of 1", False)
+    # no run yet: the report is D6's state alone
+    assert linear_lines(tables, None, None) == [
+        "D6: partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)"
+    ]
 
     folder = tmp_path / "cartpole"
     (folder / "online").mkdir(parents=True)

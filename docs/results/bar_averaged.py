@@ -43,10 +43,9 @@ from bar_reruns import (
     decqn2_complete,
     decqn2_lines,
     held,
-    linear_complete,
+    linear_lines,
     linear_part,
     noise_floor,
-    rerun_lines,
 )
 from readme_tables import IQM_RUNS, MAIN_ALGOS, MAIN_TABLES, shipped
 
@@ -291,22 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         print("\n".join(text_lines(items)))
     state = "complete: the bar's items above are D5's outcome" if complete(probe) else "partial (D5 waits for seeds 0-11)"
     print(f"D5: {state}")
-    if linear_probe is not None and linear is not None:
-        print("\n".join(rerun_lines("D6", "gqn-linear", linear_probe, tables)))
-        for reading in linear:
-            print(
-                f"{reading.network}: growth events failed {len(reading.growth_failed)} of {reading.growth_pairs}; pairs "
-                f"after the last growth from 30k (reported) {len(reading.late_failed)} of {reading.late_pairs}; mean "
-                f"final return {reading.final_return:.1f}, SM {reading.final_sm:.4f}"
-            )
-            for failure in reading.growth_failed + reading.late_failed:
-                print(f"    {failure}")
-    linear_state = (
-        "complete: the bar's collapse row reads gqn-linear on the average"
-        if linear_complete(linear_probe)
-        else ("partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)")
-    )
-    print(f"D6: {linear_state}")
+    print("\n".join(linear_lines(tables, linear_probe, linear)))  # type: ignore[arg-type]
     if linear is not None and average.static is not None:
         failed = len(average.growth.growth_failed) + len(linear[1].growth_failed)
         events = average.growth.growth_pairs + linear[1].growth_pairs

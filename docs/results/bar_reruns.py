@@ -75,6 +75,31 @@ def linear_complete(linear_probe: pd.DataFrame | None) -> bool:
     return linear_probe is not None and complete_on(linear_probe, LINEAR_SEEDS, ["gqn-linear"])
 
 
+def linear_lines(
+    tables: pd.DataFrame,
+    linear_probe: pd.DataFrame | None,
+    linear: tuple[NetworkReading, NetworkReading] | None,
+) -> list[str]:
+    """D6's report: ``rerun_lines``, then gqn-linear's growth events, late pairs, final return and SM on each network
+    (``linear``: its readings, online then average), and D6's state (partial until ``linear_complete``)."""
+    lines = []
+    if linear_probe is not None and linear is not None:
+        lines = rerun_lines("D6", "gqn-linear", linear_probe, tables)
+        for reading in linear:
+            lines.append(
+                f"{reading.network}: growth events failed {len(reading.growth_failed)} of {reading.growth_pairs}; pairs "
+                f"after the last growth from 30k (reported) {len(reading.late_failed)} of {reading.late_pairs}; mean "
+                f"final return {reading.final_return:.1f}, SM {reading.final_sm:.4f}"
+            )
+            lines += [f"    {failure}" for failure in reading.growth_failed + reading.late_failed]
+    state = (
+        "complete: the bar's collapse row reads gqn-linear on the average"
+        if linear_complete(linear_probe)
+        else "partial (D6 waits for gqn-linear's seeds 0-5 on all three tasks; the bar keeps its recorded count)"
+    )
+    return [*lines, f"D6: {state}"]
+
+
 def held(reading: NetworkReading) -> str:
     """``N of M scored events hold`` and the failed events."""
     failed = reading.growth_failed
