@@ -16,8 +16,8 @@ venv: $(VENV)/.installed
 # Main job (~7-10 min on 2 cores): GQN on penalized cartpole-swingup (learning curve, final evaluation), then the
 # short comparison suite (GQN vs DecQN 2/9 vs SAC on penalized Pendulum: table and plots) into results/
 results: venv
-	$(BIN)/python -m sb3_gqn.reference_run --out results --timesteps 50000
-	$(BIN)/python -m sb3_gqn.benchmark --out results/benchmark
+	$(BIN)/sb3-gqn reference-run --out results --timesteps 50000
+	$(BIN)/sb3-gqn benchmark --out results/benchmark
 
 lint: venv
 	$(BIN)/ruff check .

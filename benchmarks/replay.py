@@ -6,7 +6,7 @@
 Buffers hold humanoid-sized transitions (67-dimensional float32 observations, 21 action dimensions
 of 9 bins) and are filled to 10^4, 10^5 and 10^6 transitions with random priorities. It prints
 milliseconds per sample(256) of SB3's NStepReplayBuffer and of
-sb3_gqn.buffers.PrioritizedReplayBuffer, per update_priorities(256), their ratio, the
+sb3_gqn.common.buffers.PrioritizedReplayBuffer, per update_priorities(256), their ratio, the
 bytes per stored transition, and the PER overhead relative to one GQN gradient step (512x512 MLP,
 batch 256) measured on the same data. With cpprb installed it also times cpprb's C++ prioritized
 buffer (its own storage, not SB3's) for reference.
@@ -26,7 +26,7 @@ from stable_baselines3.common.buffers import NStepReplayBuffer, ReplayBuffer
 from stable_baselines3.common.logger import configure
 
 from sb3_gqn import GQN
-from sb3_gqn.buffers import PrioritizedReplayBuffer
+from sb3_gqn.common.buffers import PrioritizedReplayBuffer
 
 OBS_DIM, ACTION_DIMS, BINS, BATCH = 67, 21, 9, 256
 

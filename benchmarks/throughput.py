@@ -43,7 +43,7 @@ from stable_baselines3.common.policies import BasePolicy
 from torch import nn
 
 from sb3_gqn import GQN
-from sb3_gqn.envs import make_env
+from sb3_gqn.common.envs import make_env
 
 CARTPOLE = "dm_control/cartpole-swingup-v0"
 HUMANOID = "dm_control/humanoid-walk-v0"

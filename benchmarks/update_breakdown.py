@@ -29,8 +29,8 @@ from throughput import CARTPOLE, forward_flops, matmul_peak, seconds_per_call
 from torch import nn
 
 from sb3_gqn import GQN
-from sb3_gqn.envs import make_env
-from sb3_gqn.targets import clip_grad_norm, decoupled_q_value, double_q_target, huber_td_loss
+from sb3_gqn.common.envs import make_env
+from sb3_gqn.common.targets import clip_grad_norm, decoupled_q_value, double_q_target, huber_td_loss
 
 
 def milliseconds_per_call(function: Callable[[], object], calls: int) -> float:

@@ -8,7 +8,7 @@ import pytest
 from gymnasium import spaces
 
 from sb3_gqn import GQN, DecQN
-from sb3_gqn.buffers import PrioritizedReplayBuffer
+from sb3_gqn.common.buffers import PrioritizedReplayBuffer
 
 BAD_ARGUMENTS = [
     # (argument, bad value, the valid range the message states)

@@ -13,9 +13,34 @@ from pathlib import Path
 
 import pytest
 
-import sb3_gqn.benchmark as benchmark
-from sb3_gqn.benchmark import COLUMNS, collect, main, parse_args
-from sb3_gqn.variants import RunSpec, learning_starts, penalized_wrappers, untrained_runs, warm_started
+import sb3_gqn.experiments.runs as runs_module
+from sb3_gqn.experiments.runner import main, parse_args
+from sb3_gqn.experiments.runs import COLUMNS, collect
+from sb3_gqn.experiments.variants import (
+    VARIANTS,
+    RunSpec,
+    learning_starts,
+    load_variants,
+    penalized_wrappers,
+    run_overrides,
+    untrained_runs,
+    warm_started,
+)
+from sb3_gqn.zoo.hyperparams import shipped_entry
+
+RESEARCH_VARIANTS = Path(__file__).resolve().parents[1] / "docs" / "research" / "variants.yml"
+load_variants(RESEARCH_VARIANTS)  # the research record's agents, which the committed tables hold
+REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
+RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
+#: the paper as written, the research ablation's starting point
+BEFORE_GROWTH_FIXES = {
+    "growth": "adaptive",
+    "growth_init": "none",
+    "growth_patience": None,
+    "growth_eval_freq": 5_000,
+    "exploration": "per_dimension",
+    "acting_tau": None,
+}
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
@@ -32,9 +57,9 @@ def _drop_rows(table, algo):
 
 def test_penalized_wrappers_replace_only_the_penalty():
     flatten = "gymnasium.wrappers.FlattenObservation"
-    entry = [flatten, {"sb3_gqn.wrappers.ActionPenalty": {"coef": 0.1}}]
-    assert penalized_wrappers(entry, 0.5) == [flatten, {"sb3_gqn.wrappers.ActionPenalty": {"coef": 0.5}}]
-    assert penalized_wrappers(None, 0.0) == [{"sb3_gqn.wrappers.ActionPenalty": {"coef": 0.0}}]
+    entry = [flatten, {"sb3_gqn.common.wrappers.ActionPenalty": {"coef": 0.1}}]
+    assert penalized_wrappers(entry, 0.5) == [flatten, {"sb3_gqn.common.wrappers.ActionPenalty": {"coef": 0.5}}]
+    assert penalized_wrappers(None, 0.0) == [{"sb3_gqn.common.wrappers.ActionPenalty": {"coef": 0.0}}]
     spec = RunSpec("decqn-2", "dm_control/walker-walk-v0", 0.5, 3, 10)
     assert spec.name == "decqn-2__dm_control-walker-walk-v0__c0.5__seed3"
 
@@ -142,14 +167,14 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
             writer.writeheader()
             writer.writerow(row)
         (run_dir / "done.json").write_text(json.dumps({}))
-    read_table = benchmark.recorded_rows
+    read_table = runs_module.recorded_rows
 
     def slow_read(table):
         rows = read_table(table)
         time.sleep(0.3)
         return rows
 
-    monkeypatch.setattr(benchmark, "recorded_rows", slow_read)
+    monkeypatch.setattr(runs_module, "recorded_rows", slow_read)
     threads = [threading.Thread(target=collect, args=([spec], out)) for spec in specs]
     for thread in threads:
         thread.start()
@@ -160,19 +185,10 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
     assert not list(out.glob("*.tmp"))
 
 
-def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
-    from sb3_gqn.variants import ABLATION, BEFORE_GROWTH_FIXES, VARIANTS
-
-    assert BEFORE_GROWTH_FIXES == {
-        "growth": "adaptive",
-        "growth_init": "none",
-        "growth_patience": None,
-        "growth_eval_freq": 5_000,
-        "exploration": "per_dimension",
-        "acting_tau": None,  # predict on the online network, as every run before rule D4
-    }
-    for name in ABLATION[1:-1]:
-        changed = {key for key, value in VARIANTS[name][1].items() if BEFORE_GROWTH_FIXES.get(key) != value}
+def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each():
+    assert VARIANTS["gqn-before"].hyperparams == BEFORE_GROWTH_FIXES
+    for name in ["gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared"]:
+        changed = {key for key, value in VARIANTS[name].hyperparams.items() if BEFORE_GROWTH_FIXES.get(key) != value}
         assert (
             changed
             == {
@@ -185,8 +201,6 @@ def test_ablation_variants_differ_from_the_defaults_in_one_change_each():
 
 def trained(algo: str, env: str) -> dict:
     """The hyperparameters the runner trains ``algo`` with on ``env``: the shipped entry with the variant's overrides."""
-    from sb3_gqn.variants import run_overrides, shipped_entry
-
     zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
     return {**shipped_entry(zoo_algo, env), **overrides}
 
@@ -200,11 +214,9 @@ def readme_tables():
 
 
 def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants():
-    """sb3_gqn.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
+    """sb3_gqn.experiments.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
     residual torso, by rule R1; finger: DecQN's default torso)."""
-    from sb3_gqn.variants import BEFORE_GROWTH_FIXES, REFERENCE_TORSO, RESIDUAL_TORSO, run_overrides
-
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
     assert {walker: "+residual+1update", finger: "+layernorm+1update"} == readme_tables().SHIPPED
@@ -233,8 +245,6 @@ def test_the_torso_variants_differ_from_the_entries_only_in_the_torso():
     """Issue 11 item 5: walker's earlier entry (``+layernorm+1update``) and finger's residual candidate
     (``+residual+1update``) each train the task's shipped entry with the other torso and nothing else changed, so
     their runs compare with the shipped ones seed for seed."""
-    from sb3_gqn.variants import REFERENCE_TORSO, RESIDUAL_TORSO
-
     walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         for env, other, torso in [
@@ -276,7 +286,7 @@ def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
     entry was compared with itself on another probe's seeds)."""
     import pandas as pd
 
-    from sb3_gqn.report import comparisons_per_task
+    from sb3_gqn.experiments.report import comparisons_per_task
 
     tables = readme_tables()
     finger = "dm_control/finger-spin-v0"
@@ -324,7 +334,9 @@ def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
     assert merged.splitlines() == ["| env | x |", "| --- | --- |", "| a | 2 |", "| a | 3 |", "| b | 1 |"]
 
 
-@pytest.mark.parametrize("module", ["sb3_gqn.benchmark", "sb3_gqn.reference_run", "sb3_gqn.report"])
+@pytest.mark.parametrize(
+    "module", ["sb3_gqn.experiments.runner", "sb3_gqn.experiments.reference_run", "sb3_gqn.experiments.report"]
+)
 def test_help_texts_are_plain_text(module, capsys):
     entry_point = importlib.import_module(module).main
     with pytest.raises(SystemExit):
@@ -338,7 +350,7 @@ def test_the_local_runner_imports_no_ray():
     import sys
 
     code = (
-        "import sys; from sb3_gqn.benchmark import main\n"
+        "import sys; from sb3_gqn.experiments.runner import main\n"
         "main(['--algos', 'gqn-linear', '--envs', 'Pendulum-v1', '--list'])\n"
         "print('ray' in sys.modules)"
     )
@@ -358,7 +370,7 @@ def test_warm_started_is_every_variant_but_the_cold_ablation():
 def test_two_critics_keep_the_entry_torso():
     """``gqn-adaptive+twin`` adds DecQN's second critic to the entry's own torso (walker's residual one: the reference
     as its experiments run it), not in place of it."""
-    from sb3_gqn.variants import added_policy_kwargs
+    from sb3_gqn.experiments.variants import added_policy_kwargs
 
     assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
         "dict(residual_layer_norm=True, n_critics=2)"

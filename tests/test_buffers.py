@@ -11,8 +11,8 @@ from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
 
 from sb3_gqn import GQN
-from sb3_gqn.buffers import PrioritizedReplayBuffer
-from sb3_gqn.targets import huber_td_loss
+from sb3_gqn.common.buffers import PrioritizedReplayBuffer
+from sb3_gqn.common.targets import huber_td_loss
 from tests.envs import DecliningEnv
 
 OBS = spaces.Box(-np.inf, np.inf, (2,), np.float32)

@@ -46,7 +46,7 @@ def test_importing_sb3_gqn_does_not_import_the_suites():
 
 def test_no_display_warning_when_making_a_dm_control_env_headless():
     environment = {key: value for key, value in os.environ.items() if key not in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY")}
-    code = "import os; from sb3_gqn.envs import make_env\nmake_env('dm_control/cartpole-swingup-v0')\n"
+    code = "import os; from sb3_gqn.common.envs import make_env\nmake_env('dm_control/cartpole-swingup-v0')\n"
     code += "print(os.environ['MUJOCO_GL'])"
     result = subprocess.run(
         [sys.executable, "-W", "default", "-c", code], capture_output=True, text=True, timeout=120, env=environment
@@ -57,7 +57,7 @@ def test_no_display_warning_when_making_a_dm_control_env_headless():
 
 
 def test_the_headless_backend_choice_respects_the_users_settings(monkeypatch):
-    from sb3_gqn.envs import choose_headless_gl_backend
+    from sb3_gqn.common.envs import choose_headless_gl_backend
 
     monkeypatch.setenv("MUJOCO_GL", "osmesa")
     assert choose_headless_gl_backend() is None

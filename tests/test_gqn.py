@@ -8,8 +8,8 @@ from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.logger import configure
 
 from sb3_gqn import GQN, DecQN
-from sb3_gqn.growth import AdaptiveGrowth, linear_growth_level
-from sb3_gqn.masking import active_bin_indices
+from sb3_gqn.common.masking import active_bin_indices
+from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth, linear_growth_level
 from tests.envs import DecliningEnv
 
 SMALL = dict(policy_kwargs=dict(net_arch=[32, 32]), learning_starts=100, buffer_size=10_000, batch_size=32, seed=0)
@@ -193,8 +193,8 @@ def test_dict_observations_with_multi_input_policy():
 def test_dict_observations_get_n_step_and_prioritized_replay_by_default():
     from stable_baselines3.common.buffers import DictReplayBuffer
 
-    from sb3_gqn.buffers import PrioritizedDictReplayBuffer
-    from sb3_gqn.nstep_dict import NStepDictReplayBuffer
+    from sb3_gqn.common.buffers import PrioritizedDictReplayBuffer
+    from sb3_gqn.common.nstep_dict import NStepDictReplayBuffer
 
     model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), **SMALL)
     assert type(model.replay_buffer) is PrioritizedDictReplayBuffer and model.replay_buffer.n_steps == 3
@@ -250,7 +250,7 @@ def test_sb3_evaluation_tools_work_on_the_box_env():
     from stable_baselines3.common.evaluation import evaluate_policy
     from stable_baselines3.common.monitor import Monitor
 
-    from sb3_gqn.wrappers import ActionPenalty
+    from sb3_gqn.common.wrappers import ActionPenalty
 
     model = GQN("MlpPolicy", DecliningEnv(), **SMALL)
     rewards, _ = evaluate_policy(model, Monitor(ActionPenalty(DecliningEnv(), coef=0.1)), 2, return_episode_rewards=True)

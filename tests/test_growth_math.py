@@ -3,7 +3,13 @@
 import numpy as np
 import pytest
 
-from sb3_gqn.growth import AdaptiveGrowth, adaptive_threshold, interpolation_neighbours, linear_growth_level, plateau
+from sb3_gqn.gqn.growth.schedules import (
+    AdaptiveGrowth,
+    adaptive_threshold,
+    interpolation_neighbours,
+    linear_growth_level,
+    plateau,
+)
 
 
 def test_adaptive_threshold_positive_mean():

@@ -5,8 +5,8 @@ import pytest
 from stable_baselines3.common.monitor import Monitor
 
 from sb3_gqn import GQN
-from sb3_gqn.envs import make_env
-from sb3_gqn.evaluation import evaluate
+from sb3_gqn.common.envs import make_env
+from sb3_gqn.common.evaluation import evaluate
 
 
 @pytest.mark.slow

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 import torch as th
 
-from sb3_gqn.growth import nested_bin_levels
-from sb3_gqn.masking import (
+from sb3_gqn.common.masking import (
     active_bin_indices,
     active_bin_mask,
     epsilon_greedy,
@@ -15,6 +14,7 @@ from sb3_gqn.masking import (
     masked_max,
     random_dimension_probability,
 )
+from sb3_gqn.gqn.growth.schedules import nested_bin_levels
 
 
 @pytest.mark.parametrize(

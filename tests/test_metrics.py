@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from sb3_gqn.metrics import bin_usage, control_frequency, normalized_actions, rollout_figures, smoothness
-from sb3_gqn.wrappers import ActionPenalty
+from sb3_gqn.common.evaluation import rollout_figures
+from sb3_gqn.common.smoothness import bin_usage, control_frequency, normalized_actions, smoothness
+from sb3_gqn.common.wrappers import ActionPenalty
 
 
 def test_constant_action_is_perfectly_smooth():

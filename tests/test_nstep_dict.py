@@ -6,8 +6,8 @@ import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
 
-from sb3_gqn.buffers import PrioritizedDictReplayBuffer, PrioritizedReplayBuffer
-from sb3_gqn.nstep_dict import NStepDictReplayBuffer
+from sb3_gqn.common.buffers import PrioritizedDictReplayBuffer, PrioritizedReplayBuffer
+from sb3_gqn.common.nstep_dict import NStepDictReplayBuffer
 
 BOX = spaces.Box(-100, 100, (2,), dtype=np.float32)
 DICT = spaces.Dict({"state": BOX})

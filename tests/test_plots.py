@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import sb3_gqn.plots as plots
+import sb3_gqn.experiments.plots as plots
 from sb3_gqn import GQN
-from sb3_gqn.plots import (
+from sb3_gqn.experiments.plots import (
     RADAR_CLIP,
     aggregate,
     clipped_radii,
@@ -96,7 +96,7 @@ def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
 def test_iqm_intervals_are_seeded_and_leave_the_global_numpy_stream_alone():
     """Regenerating the README's IQM table or figure gives the same intervals (rliable draws from NumPy's global
     generator); another seed gives other draws; the caller's stream continues where it was."""
-    from sb3_gqn.plots import iqm_with_intervals
+    from sb3_gqn.experiments.plots import iqm_with_intervals
 
     scores = {"a": np.random.default_rng(0).random((6, 3)), "b": np.random.default_rng(1).random((5, 3))}
     np.random.seed(7)

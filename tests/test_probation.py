@@ -9,9 +9,9 @@ import pytest
 import torch as th
 
 from sb3_gqn import GQN
-from sb3_gqn.growth import AdaptiveGrowth, probation_holds
-from sb3_gqn.masking import active_bin_mask
-from sb3_gqn.report import growth_checks
+from sb3_gqn.common.masking import active_bin_mask
+from sb3_gqn.experiments.report import growth_checks
+from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth, probation_holds
 from tests.envs import DecliningEnv, FlatEnv
 
 SMALL = dict(policy_kwargs=dict(net_arch=[32, 32]), learning_starts=100, buffer_size=10_000, batch_size=32, seed=0)
@@ -119,7 +119,7 @@ def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_lev
 
 
 def test_on_probation_the_td_target_maximizes_over_the_deployed_level(monkeypatch):
-    import sb3_gqn.gqn as gqn_module
+    import sb3_gqn.gqn.gqn as gqn_module
 
     model = GQN("MlpPolicy", DecliningEnv(), growth_probation=2, **SMALL)
     model.learn(150)  # fills the buffer, no growth decision yet (window 3 of 2 500-step evaluations)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from sb3_gqn.processes import run_in_processes
+from sb3_gqn.experiments.processes import run_in_processes
 
 
 def _alive(pid: int) -> bool:
@@ -47,7 +47,7 @@ def test_sigterm_stops_the_workers_too(tmp_path):
     script = tmp_path / "suite.py"
     script.write_text(
         "import multiprocessing, time\n"
-        "from sb3_gqn.processes import run_in_processes\n"
+        "from sb3_gqn.experiments.processes import run_in_processes\n"
         "def report(keys):\n"
         "    print(' '.join(str(child.pid) for child in multiprocessing.active_children()), flush=True)\n"
         "if __name__ == '__main__':\n"

@@ -17,8 +17,8 @@ import pytest
 
 ray = pytest.importorskip("ray")
 
-from sb3_gqn.benchmark import main  # noqa: E402
-from sb3_gqn.ray_suite import progress_board_name  # noqa: E402
+from sb3_gqn.experiments.ray_runner import progress_board_name  # noqa: E402
+from sb3_gqn.experiments.runner import main  # noqa: E402
 
 pytestmark = pytest.mark.slow  # two clusters and a few short trainings: ~2 minutes on 2 cores
 

@@ -3,29 +3,31 @@
 import csv
 import json
 
-from sb3_gqn import reference_run
+from sb3_gqn.experiments import reference_run
 
 
 def test_reference_run_writes_results(tmp_path):
-    summary = reference_run.main(
-        [
-            "--env",
-            "Pendulum-v1",
-            "--timesteps",
-            "1200",
-            "--eval-freq",
-            "600",
-            "--eval-episodes",
-            "1",
-            "--final-episodes",
-            "2",
-            "--growth",
-            "linear",
-            "--out",
-            str(tmp_path),
-            "--verbose",
-            "0",
-        ]
+    summary = reference_run.train_and_evaluate(
+        reference_run.parse_args(
+            [
+                "--env",
+                "Pendulum-v1",
+                "--timesteps",
+                "1200",
+                "--eval-freq",
+                "600",
+                "--eval-episodes",
+                "1",
+                "--final-episodes",
+                "2",
+                "--growth",
+                "linear",
+                "--out",
+                str(tmp_path),
+                "--verbose",
+                "0",
+            ]
+        )
     )
     run_dir = tmp_path / summary["run"]
     for name in ("learning_curve.csv", "learning_curve.png", "final_evaluation.json", "model.zip", "progress.csv"):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from sb3_gqn.report import as_shipped, growth_checks, held_after_growth, main, report
+from sb3_gqn.experiments.report import as_shipped, growth_checks, held_after_growth, main, report
 
 
 def test_held_after_growth_hand_values():

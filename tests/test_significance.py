@@ -1,4 +1,4 @@
-"""How far comparisons are resolved (sb3_gqn.significance) and the report's comparison tables, against hand values."""
+"""How far comparisons are resolved (sb3_gqn.experiments.significance) and the report's comparison tables, by hand."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from sb3_gqn.report import main, report_sections
-from sb3_gqn.significance import (
+from sb3_gqn.experiments.report import main, report_sections
+from sb3_gqn.experiments.significance import (
     difference_interval,
     iqm_difference,
     mean_difference,

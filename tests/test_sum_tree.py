@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sb3_gqn.sum_tree import SumTree
+from sb3_gqn.common.sum_tree import SumTree
 
 
 def in_order_leaves(capacity: int) -> list[int]:

@@ -6,7 +6,7 @@ import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer
 
-from sb3_gqn.targets import decoupled_q_value, double_q_target
+from sb3_gqn.common.targets import decoupled_q_value, double_q_target
 
 
 def test_decoupled_q_value_is_mean_of_chosen_utilities():
@@ -69,7 +69,7 @@ def test_double_q_target_with_sb3_n_step_buffer():
 
 @pytest.mark.parametrize("max_norm", [10.0, 5.0 + 1e-6, 2.5, 0.1])
 def test_clip_grad_norm_by_hand_and_equal_to_pytorch(max_norm):
-    from sb3_gqn.targets import clip_grad_norm
+    from sb3_gqn.common.targets import clip_grad_norm
 
     def parameters_with_grads() -> list[th.nn.Parameter]:
         first, second, third = th.nn.Parameter(th.zeros(2)), th.nn.Parameter(th.zeros(1)), th.nn.Parameter(th.zeros(3))
@@ -87,7 +87,7 @@ def test_clip_grad_norm_by_hand_and_equal_to_pytorch(max_norm):
 
 
 def test_clip_grad_norm_passes_a_nan_norm_on_like_pytorch():
-    from sb3_gqn.targets import clip_grad_norm
+    from sb3_gqn.common.targets import clip_grad_norm
 
     parameter = th.nn.Parameter(th.zeros(2))
     parameter.grad = th.tensor([float("nan"), 1.0])
@@ -97,7 +97,7 @@ def test_clip_grad_norm_passes_a_nan_norm_on_like_pytorch():
 
 def test_critic_ensemble_targets_hand_computed():
     """DecQN's use_double_q: each critic's online net selects, the mean of the target nets scores."""
-    from sb3_gqn.targets import critic_ensemble_targets
+    from sb3_gqn.common.targets import critic_ensemble_targets
 
     online_1 = th.tensor([[[1.0, 3.0, 2.0]]])  # argmax 1; over the active {0, 2}: 2
     online_2 = th.tensor([[[5.0, 0.0, 0.0]]])  # argmax 0
@@ -122,7 +122,7 @@ def test_critic_ensemble_targets_hand_computed():
 
 
 def test_critic_ensemble_loss_adds_the_losses_and_averages_the_td_errors():
-    from sb3_gqn.targets import critic_ensemble_loss
+    from sb3_gqn.common.targets import critic_ensemble_loss
 
     currents = [th.tensor([0.0, 0.0]), th.tensor([1.0, 0.0])]
     targets = [th.tensor([0.5, 3.0]), th.tensor([1.0, 1.0])]

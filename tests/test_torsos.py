@@ -10,7 +10,7 @@ import torch as th
 from torch import nn
 
 from sb3_gqn import GQN
-from sb3_gqn.torsos import ResidualLayerNormMLP, variance_scaling_uniform_
+from sb3_gqn.common.torsos import ResidualLayerNormMLP, variance_scaling_uniform_
 from tests.envs import DecliningEnv
 
 

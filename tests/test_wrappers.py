@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from sb3_gqn.wrappers import ActionPenalty, DiscretizeAction
+from sb3_gqn.common.wrappers import ActionPenalty, DiscretizeAction
 
 
 class RecordingEnv(gym.Env):

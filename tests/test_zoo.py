@@ -15,10 +15,12 @@ import pytest
 import yaml
 
 from sb3_gqn import GQN
-from sb3_gqn.enjoy import main as enjoy_main
-from sb3_gqn.train import main as train_main
-from sb3_gqn.tuning import convert_gqn_params, sample_decqn_params, sample_gqn_params
-from sb3_gqn.zoo import HYPERPARAMS_DIR, default_train_arguments, loader_without_replay_memory, register
+from sb3_gqn.zoo.cli import default_train_arguments
+from sb3_gqn.zoo.cli import enjoy as enjoy_main
+from sb3_gqn.zoo.cli import train as train_main
+from sb3_gqn.zoo.hyperparams import HYPERPARAMS_DIR
+from sb3_gqn.zoo.registration import loader_without_replay_memory, register
+from sb3_gqn.zoo.tuning import convert_gqn_params, sample_decqn_params, sample_gqn_params
 
 SHIPPED_ALGOS = ("gqn", "decqn", "sac", "td3")
 # Small enough for a few seconds per run; learning_starts below the budget so that gradient steps happen
@@ -107,7 +109,7 @@ def test_train_then_enjoy_each_shipped_algorithm(algo, tmp_path):
     assert (run_folder / "Pendulum-v1.zip").is_file() and (run_folder / "0.monitor.csv").is_file()
     with open(run_folder / "Pendulum-v1" / "config.yml") as handle:
         saved = dict(yaml.load(handle, Loader=yaml.UnsafeLoader))
-    assert "sb3_gqn.wrappers.ActionPenalty" in str(saved["env_wrapper"])  # the shipped entry was used
+    assert "sb3_gqn.common.wrappers.ActionPenalty" in str(saved["env_wrapper"])  # the shipped entry was used
     arguments = ["--algo", algo, "--env", "Pendulum-v1", "-f", str(tmp_path), "--no-render", "-n", "250", "--seed", "0"]
     assert enjoy_main(arguments) == 0
 
@@ -115,7 +117,7 @@ def test_train_then_enjoy_each_shipped_algorithm(algo, tmp_path):
 def test_record_video_and_plot_train_work_on_the_logs(tmp_path, monkeypatch):
     import matplotlib
 
-    from sb3_gqn.record_video import main as record_video_main
+    from sb3_gqn.zoo.cli import record_video as record_video_main
 
     matplotlib.use("Agg")
     assert train_main(["--algo", "gqn", "--env", "Pendulum-v1", "-f", str(tmp_path), *QUICK]) == 0
@@ -181,14 +183,14 @@ def test_bad_hyperparameter_file_entry(entry, message, tmp_path, capsys):
     arguments = ["--algo", "gqn", "--env", "Pendulum-v1", "-conf", str(config), "-f", str(tmp_path), "--verbose", "0"]
     assert train_main(arguments) == 1
     error = capsys.readouterr().err.strip().splitlines()
-    assert len(error) == 1 and message in error[0] and error[0].startswith("sb3_gqn.train: error:")
+    assert len(error) == 1 and message in error[0] and error[0].startswith("sb3-gqn train: error:")
 
 
 def test_console_scripts_are_installed():
     scripts = Path(sys.executable).parent
-    for name in ("sb3-gqn-train", "sb3-gqn-enjoy", "sb3-gqn-record-video"):
-        completed = subprocess.run([scripts / name, "--help"], capture_output=True, text=True, timeout=300)
-        assert completed.returncode == 0 and "--algo" in completed.stdout and "gqn" in completed.stdout
+    for command in (["sb3-gqn", "train"], ["sb3-gqn", "enjoy"], ["sb3-gqn", "record-video"], ["sb3-gqn-train"]):
+        completed = subprocess.run([scripts / command[0], *command[1:], "--help"], capture_output=True, text=True, timeout=300)
+        assert completed.returncode == 0 and "--algo" in completed.stdout and "gqn" in completed.stdout, command
 
 
 def test_bad_input_from_the_command_line(tmp_path):
@@ -200,7 +202,7 @@ def test_bad_input_from_the_command_line(tmp_path):
     )
     assert completed.returncode == 1
     assert completed.stderr.strip().splitlines() == [
-        "sb3_gqn.train: error: ValueError: NoSuchEnv-v0 not found in gym registry, you maybe meant "
+        "python -m sb3_gqn.train: error: ValueError: NoSuchEnv-v0 not found in gym registry, you maybe meant "
         + completed.stderr.split("you maybe meant ")[1].strip()
     ]
 
@@ -272,9 +274,7 @@ def test_every_shipped_entry_builds_its_env_and_model(algo, env_id, tmp_path):
 
 
 def test_a_missing_entry_points_to_conf_and_the_readme(capsys, tmp_path):
-    from sb3_gqn.train import main
-
-    assert main(["--algo", "gqn", "--env", "CartPole-v1", "-f", str(tmp_path), "-n", "10"]) == 1
+    assert train_main(["--algo", "gqn", "--env", "CartPole-v1", "-f", str(tmp_path), "-n", "10"]) == 1
     error = capsys.readouterr().err
     assert "Hyperparameters not found for gqn-CartPole-v1" in error
     assert "-conf my_hyperparams.yml" in error and '"Train GQN on your own task"' in error

@@ -2,7 +2,7 @@
 
 Each block sits between ``<!-- BEGIN generated: NAME -->`` and ``<!-- END generated: NAME -->`` in
 ``docs/results/README.md`` (issue 11's results report; the top-level README keeps the bar at a glance) and
-is the output of ``sb3_gqn.report`` on the committed ``docs/results/*/results.csv`` files; the prose around
+is the output of ``sb3_gqn.experiments.report`` on the committed ``docs/results/*/results.csv`` files; the prose around
 the blocks (what the figures mean, what misses) is written by hand. Figures go to ``docs/results/main``.
 Run from the repository root after extending a table with the comparison runner.
 """
@@ -15,8 +15,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from sb3_gqn.plots import aggregate, learning_curves, smoothness_radar
-from sb3_gqn.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
+from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
+from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
+from sb3_gqn.experiments.variants import load_variants
+
+load_variants(Path(__file__).resolve().parents[1] / "research" / "variants.yml")  # the tables hold the research agents too
 
 RESULTS = Path("docs/results")
 #: the report the blocks live in; its links are relative to ``docs/results``

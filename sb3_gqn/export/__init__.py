@@ -23,7 +23,7 @@ from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecNormalize
 
 from sb3_gqn.export.policy import DeployedPolicy
-from sb3_gqn.gqn import GQN
+from sb3_gqn.gqn.gqn import GQN
 
 __all__ = ["DeployedPolicy", "export_onnx", "export_torchscript"]
 

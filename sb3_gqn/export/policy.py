@@ -11,11 +11,11 @@ from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecNormalize
 from torch import nn
 
-from sb3_gqn.masking import masked_argmax
-from sb3_gqn.q_network import DecoupledQNetwork, critics_maximum
+from sb3_gqn.common.masking import masked_argmax
+from sb3_gqn.gqn.q_network import DecoupledQNetwork, critics_maximum
 
 if TYPE_CHECKING:
-    from sb3_gqn.gqn import GQN
+    from sb3_gqn.gqn.gqn import GQN
 
 Observation = th.Tensor | dict[str, th.Tensor]
 

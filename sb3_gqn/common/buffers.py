@@ -1,0 +1,287 @@
+"""Prioritized n-step replay (Schaul et al. 2016) on top of SB3's ``NStepReplayBuffer`` (array observations) and
+:class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer` (``Dict`` observations)."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, NamedTuple
+
+import numpy as np
+import torch as th
+from gymnasium import spaces
+from stable_baselines3.common.buffers import NStepReplayBuffer, ReplayBuffer
+from stable_baselines3.common.type_aliases import TensorDict
+from stable_baselines3.common.vec_env import VecNormalize
+
+from sb3_gqn.common.arguments import check_int, check_number
+from sb3_gqn.common.nstep_dict import NStepDictReplayBuffer
+from sb3_gqn.common.sum_tree import SumTree, check_priorities
+
+# The per-(row, env) arrays of SB3's ReplayBuffer; an env's column of each is a view of it.
+_TRANSITION_ARRAYS = ("observations", "next_observations", "actions", "rewards", "dones", "timeouts")
+
+
+class PrioritizedReplayBufferSamples(NamedTuple):
+    """SB3's ``ReplayBufferSamples`` fields plus the importance-sampling weights and the sampled indices."""
+
+    observations: th.Tensor | TensorDict
+    actions: th.Tensor
+    next_observations: th.Tensor | TensorDict
+    dones: th.Tensor
+    rewards: th.Tensor
+    discounts: th.Tensor | None
+    #: importance-sampling weights ``(N * P(i)) ** -beta``, normalized by the batch maximum, shape ``(batch, 1)``
+    weights: th.Tensor
+    #: the sampled transitions' indices, ``row * n_envs + env``; pass them back to ``update_priorities``
+    indices: np.ndarray
+
+
+class PrioritizedSampling:
+    """
+    Proportional prioritized replay (Schaul et al. 2016) for an n-step buffer (mixed in before it).
+
+    Storage, ``add`` and the n-step return computation are the n-step buffer's, unchanged (``n_steps=1``
+    gives one-step returns). A :class:`~sb3_gqn.common.sum_tree.SumTree` holds one priority per stored transition
+    (``buffer_size`` rows times ``n_envs`` columns, 16 bytes each). ``sample`` draws transition ``i`` with
+    probability ``P(i) = p_i / sum_k p_k`` (stratified, Schaul et al. appendix B.2.1) and returns, besides
+    SB3's fields, the importance-sampling weights ``w_i = (N * P(i)) ** -beta / max_j w_j`` (the maximum taken
+    over the batch, as DecQN's Acme agents do) and the indices for :meth:`update_priorities`. New
+    transitions get the largest priority seen so far, so each is sampled at least about as often as the
+    most surprising old one.
+
+    :param buffer_size: Max number of element in the buffer
+    :param observation_space: Observation space
+    :param action_space: Action space
+    :param device: PyTorch device
+    :param n_envs: Number of parallel environments
+    :param optimize_memory_usage: Not supported (as in ``NStepReplayBuffer``)
+    :param handle_timeout_termination: Handle timeout termination (due to timelimit)
+        separately and treat the task as infinite horizon task.
+        https://github.com/DLR-RM/stable-baselines3/issues/284
+    :param n_steps: Number of steps to accumulate rewards for n-step returns
+    :param gamma: Discount factor for future rewards
+    :param alpha: priority exponent: a TD error ``|td|`` gives priority ``(|td| + epsilon) ** alpha``
+        (0: uniform sampling)
+    :param beta: importance-sampling exponent (0: no correction, 1: full correction); may be changed
+        between calls to ``sample`` (GQN anneals it when asked to)
+    :param epsilon: added to ``|td|`` so that no transition gets priority zero
+    """
+
+    #: the n-step buffer class whose ``_get_samples`` computes the samples (set by the concrete classes)
+    n_step_buffer: type
+    buffer_size: int
+    n_envs: int
+    pos: int
+
+    def __init__(
+        self,
+        buffer_size: int,
+        observation_space: spaces.Space,
+        action_space: spaces.Space,
+        device: th.device | str = "auto",
+        n_envs: int = 1,
+        optimize_memory_usage: bool = False,
+        handle_timeout_termination: bool = True,
+        n_steps: int = 3,
+        gamma: float = 0.99,
+        alpha: float = 0.6,
+        beta: float = 0.2,
+        epsilon: float = 1e-6,
+    ):
+        self._check_observation_space(observation_space)
+        if optimize_memory_usage:
+            raise ValueError(
+                f"{type(self).__name__} does not support optimize_memory_usage=True (neither does SB3's "
+                "NStepReplayBuffer it builds on)"
+            )
+        check_int("buffer_size", buffer_size, 1)
+        check_int("n_steps", n_steps, 1)
+        check_number("gamma", gamma, 0.0, 1.0, low_open=True)
+        if not alpha >= 0:
+            raise ValueError(f"alpha (priority exponent) must be >= 0, got {alpha}")
+        if not epsilon > 0:
+            raise ValueError(f"epsilon must be > 0 so that no priority is zero, got {epsilon}")
+        super().__init__(  # type: ignore[call-arg]
+            buffer_size,
+            observation_space,
+            action_space,
+            device=device,
+            n_envs=n_envs,
+            optimize_memory_usage=optimize_memory_usage,
+            handle_timeout_termination=handle_timeout_termination,
+            n_steps=n_steps,
+            gamma=gamma,
+        )
+        self.alpha = alpha
+        self.beta = beta
+        self.epsilon = epsilon
+        self.priorities = SumTree(self.buffer_size * self.n_envs)
+        self.max_priority = 1.0
+
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        """Refuse an observation space the n-step buffer cannot store."""
+
+    @property
+    def beta(self) -> float:
+        """Importance-sampling exponent used by the next ``sample``."""
+        return self._beta
+
+    @beta.setter
+    def beta(self, value: float) -> None:
+        if not 0 <= value <= 1:
+            raise ValueError(f"beta (importance-sampling exponent) must lie in [0, 1], got {value}")
+        self._beta = float(value)
+
+    def add(
+        self,
+        obs: Any,
+        next_obs: Any,
+        action: np.ndarray,
+        reward: np.ndarray,
+        done: np.ndarray,
+        infos: list[dict[str, Any]],
+    ) -> None:
+        """Store one transition per env (SB3's ``add``) with the maximum priority seen so far."""
+        row = self.pos
+        super().add(obs, next_obs, action, reward, done, infos)  # type: ignore[misc]
+        first = row * self.n_envs
+        self.priorities.update_unchecked(np.arange(first, first + self.n_envs), np.full(self.n_envs, self.max_priority))
+
+    def sample(self, batch_size: int, env: VecNormalize | None = None) -> PrioritizedReplayBufferSamples:  # type: ignore[override]
+        """
+        Sample ``batch_size`` transitions in proportion to their priorities.
+
+        :param batch_size: Number of element to sample
+        :param env: associated gym VecEnv to normalize the observations/rewards when sampling
+        :return: SB3's n-step samples plus ``weights`` (tensor ``(batch, 1)``) and ``indices`` (array ``(batch,)``)
+        """
+        indices = self.priorities.sample(batch_size)
+        if self.n_envs > 1:
+            # Group the batch by env so that each group is one call of SB3's n-step code on that env's column.
+            indices = indices[np.argsort(indices % self.n_envs, kind="stable")]
+        rows, env_columns = np.divmod(indices, self.n_envs)
+
+        if self.n_envs == 1:
+            samples = self.n_step_buffer._get_samples(self, rows, env=env)
+        else:
+            parts = [
+                self.n_step_buffer._get_samples(self._env_column(int(column)), rows[env_columns == column], env=env)
+                for column in np.unique(env_columns)
+            ]
+            samples = type(parts[0])(*(_concatenate(fields) for fields in zip(*parts)))
+
+        # P(i) = p_i / sum_k p_k over the N stored transitions; w_i = (N * P(i)) ** -beta / max_j w_j
+        probabilities = self.priorities.nodes[indices + self.priorities.capacity] / self.priorities.total
+        weights = (self.size() * self.n_envs * probabilities) ** -self.beta  # type: ignore[attr-defined]
+        weights /= weights.max()
+        return PrioritizedReplayBufferSamples(
+            *samples,
+            weights=self.to_torch(weights.astype(np.float32).reshape(-1, 1)),  # type: ignore[attr-defined]
+            indices=indices,
+        )
+
+    def _env_column(self, column: int) -> PrioritizedSampling:
+        """A shallow copy whose transition arrays are views of env ``column`` only (``n_envs=1``).
+
+        SB3's ``_get_samples`` draws the env of each sample at random; running it on this one-env view
+        makes it read the env that the priorities chose, without copying or re-implementing it.
+        """
+        view = copy.copy(self)
+        view.n_envs = 1
+        for name in _TRANSITION_ARRAYS:
+            arrays = getattr(self, name)
+            if isinstance(arrays, dict):  # Dict observations: one array per key
+                setattr(view, name, {key: array[:, column : column + 1] for key, array in arrays.items()})
+            else:
+                setattr(view, name, arrays[:, column : column + 1])
+        return view
+
+    def update_priorities(self, indices: np.ndarray, td_errors: np.ndarray | th.Tensor) -> None:
+        """
+        Set the priorities of the transitions ``indices`` (as returned by ``sample``) to
+        ``(|td| + epsilon) ** alpha`` and raise the running maximum given to new transitions.
+
+        :param indices: transition indices from :attr:`PrioritizedReplayBufferSamples.indices`
+        :param td_errors: the absolute TD errors ``|td| >= 0`` of those transitions, one per index
+            (tensor or array). Negative, NaN or infinite values raise ``ValueError``: a negative value
+            means signed errors were passed, and a NaN would poison the whole tree.
+        """
+        if isinstance(td_errors, th.Tensor):
+            td_errors = td_errors.detach().cpu().numpy()
+        td_errors = np.asarray(td_errors, dtype=np.float64).reshape(-1)
+        indices = np.asarray(indices).reshape(-1)
+        if td_errors.shape != indices.shape:
+            raise ValueError(f"Got {indices.size} indices but {td_errors.size} TD errors")
+        td_errors = check_priorities(td_errors, what="TD errors (absolute values |td|)")
+        stored = self.size() * self.n_envs  # type: ignore[attr-defined]
+        if not np.issubdtype(indices.dtype, np.integer):
+            raise TypeError(f"Transition indices must be integers, got dtype {indices.dtype}")
+        if indices.size and (indices.min() < 0 or indices.max() >= stored):
+            raise IndexError(f"Transition indices must lie in [0, {stored}) (the stored transitions), got {indices}")
+        priorities = (td_errors + self.epsilon) ** self.alpha
+        self.priorities.update_unchecked(indices, priorities)
+        if priorities.size:
+            self.max_priority = max(self.max_priority, float(priorities.max()))
+
+
+def _concatenate(fields: tuple[Any, ...]) -> Any:
+    """One field of several sample batches joined: tensors concatenated (per key for ``Dict`` observations)."""
+    if isinstance(fields[0], dict):
+        return {key: th.cat([field[key] for field in fields]) for key in fields[0]}
+    return None if fields[0] is None else th.cat(fields)
+
+
+class PrioritizedReplayBuffer(PrioritizedSampling, NStepReplayBuffer):
+    """Prioritized n-step replay for array observations on SB3's ``NStepReplayBuffer`` (see :class:`PrioritizedSampling`)."""
+
+    n_step_buffer = NStepReplayBuffer
+
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        if isinstance(observation_space, spaces.Dict):
+            raise ValueError(
+                "PrioritizedReplayBuffer stores array observations: use PrioritizedDictReplayBuffer for Dict "
+                "observations (GQN picks it by itself)"
+            )
+
+
+class PrioritizedDictReplayBuffer(PrioritizedSampling, NStepDictReplayBuffer):
+    """Prioritized n-step replay for ``Dict`` observations on :class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer`
+    (see :class:`PrioritizedSampling`)."""
+
+    n_step_buffer = NStepDictReplayBuffer
+
+    def _check_observation_space(self, observation_space: spaces.Space) -> None:
+        if not isinstance(observation_space, spaces.Dict):
+            raise ValueError(f"PrioritizedDictReplayBuffer needs a Dict observation space, got {observation_space}")
+
+
+def default_replay_buffer_class(
+    replay_buffer_class: type[ReplayBuffer] | None,
+    dict_observations: bool,
+    prioritized: bool,
+    n_steps: int,
+    gamma: float,
+    alpha: float,
+    beta: float,
+) -> tuple[type[ReplayBuffer] | None, dict[str, Any]]:
+    """The replay buffer class GQN trains with, and the keyword arguments it needs beyond SB3's.
+
+    With ``prioritized`` and no class given: :class:`PrioritizedReplayBuffer` (:class:`PrioritizedDictReplayBuffer` for
+    ``Dict`` observations) with the n-step return and the priority exponents. Without: ``None`` (SB3 then picks its
+    ``NStepReplayBuffer`` or ``ReplayBuffer``), or :class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer` for
+    ``Dict`` observations with ``n_steps > 1`` (SB3 has no n-step ``Dict`` buffer). A class given is kept.
+
+    :raises ValueError: when ``prioritized`` and the class given does not sample by priority
+    """
+    if prioritized:
+        if replay_buffer_class is None:
+            chosen = PrioritizedDictReplayBuffer if dict_observations else PrioritizedReplayBuffer
+            return chosen, dict(n_steps=n_steps, gamma=gamma, alpha=alpha, beta=beta)
+        if not issubclass(replay_buffer_class, PrioritizedSampling):
+            raise ValueError(
+                f"replay_buffer_class={replay_buffer_class.__name__} is not prioritized: pass "
+                "prioritized_replay=False to train with it uniformly"
+            )
+    elif replay_buffer_class is None and dict_observations and n_steps > 1:
+        return NStepDictReplayBuffer, dict(n_steps=n_steps, gamma=gamma)
+    return replay_buffer_class, {}

@@ -1,0 +1,121 @@
+"""Gymnasium and VecEnv wrappers that make any ``Box``-action env trainable by GQN.
+
+* :class:`DiscretizeAction`: ``Box`` -> ``MultiDiscrete([bins] * dims)``, index ``k`` of a dimension
+  meaning ``low + (high - low) * k / (bins - 1)``.
+* :class:`ActionPenalty`: reward ``r - coef * sum(a_norm ** 2)`` with ``a_norm`` the action rescaled
+  to ``[-1, 1]`` (the paper's ``c_a * sum_j (a^j)^2`` on DeepMind Control's ``[-1, 1]`` actions).
+
+Both take keyword arguments only after ``env`` so rl-zoo3's ``env_wrapper`` can build them, e.g.
+``env_wrapper: [{sb3_gqn.common.wrappers.ActionPenalty: {coef: 0.1}}]``. Apply ``ActionPenalty`` to the
+continuous env, before (inside) ``DiscretizeAction``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+
+def check_finite_box(action_space: spaces.Space, what: str) -> spaces.Box:
+    """Return ``action_space`` if it is a ``Box`` with finite bounds and ``high > low``; raise otherwise."""
+    if not isinstance(action_space, spaces.Box):
+        raise TypeError(f"{what} needs a Box action space, got {action_space}")
+    if not (np.all(np.isfinite(action_space.low)) and np.all(np.isfinite(action_space.high))):
+        raise ValueError(
+            f"{what} needs finite action bounds, got low={action_space.low}, high={action_space.high}: "
+            "bins between infinite bounds are undefined; clip the action space first (e.g. gymnasium's RescaleAction)"
+        )
+    if np.any(action_space.high <= action_space.low):
+        raise ValueError(f"{what} needs high > low in every dimension, got low={action_space.low}, high={action_space.high}")
+    return action_space
+
+
+class BinGrid:
+    """The bin values of a ``Box`` discretized to ``bins`` points per dimension.
+
+    :param box: the continuous action space (finite bounds, any shape; it is flattened)
+    :param bins: bins per dimension (at least 2)
+    """
+
+    def __init__(self, box: spaces.Box, bins: int):
+        check_finite_box(box, "Discretization")
+        if isinstance(bins, bool) or not isinstance(bins, (int, np.integer)) or bins < 2:
+            raise ValueError(f"bins must be an integer >= 2, got {bins!r}")
+        self.box = box
+        self.bins = int(bins)
+        self.low = box.low.astype(np.float64).ravel()
+        self.high = box.high.astype(np.float64).ravel()
+        self.action_dims = self.low.size
+        self.discrete_space = spaces.MultiDiscrete(np.full(self.action_dims, self.bins, dtype=np.int64))
+        # values[j, k] = low_j + (high_j - low_j) * k / (bins - 1), clipped against rounding at k = bins - 1
+        fractions = np.arange(self.bins, dtype=np.float64) / (self.bins - 1)
+        values = self.low[:, None] + (self.high - self.low)[:, None] * fractions[None, :]
+        self.values = np.clip(values, self.low[:, None], self.high[:, None]).astype(box.dtype)
+        self._dim_index = np.arange(self.action_dims)
+
+    def to_continuous(self, indices: np.ndarray) -> np.ndarray:
+        """Map bin indices ``(..., action_dims)`` to continuous actions ``(..., *box.shape)``."""
+        indices = np.asarray(indices)
+        if indices.shape[-1:] != (self.action_dims,):
+            raise ValueError(f"Expected bin indices with last dimension {self.action_dims}, got shape {indices.shape}")
+        if indices.min() < 0 or indices.max() >= self.bins:
+            raise ValueError(f"Bin indices must lie in [0, {self.bins - 1}], got {indices}")
+        values = self.values[self._dim_index, indices]
+        return values.reshape(*indices.shape[:-1], *self.box.shape)
+
+
+class DiscretizeAction(gym.ActionWrapper):
+    """Turn a ``Box`` action space into ``MultiDiscrete([bins] * dims)``.
+
+    Index ``k`` in a dimension maps to ``low + (high - low) * k / (bins - 1)``, i.e. the bins are
+    ``linspace(low, high, bins)``. A multi-dimensional ``Box`` is flattened in C order.
+
+    :param env: env with a finite ``Box`` action space
+    :param bins: bins per dimension (GQN uses its finest level, e.g. 9 for ``bins=(2, 9)``)
+    """
+
+    def __init__(self, env: gym.Env, bins: int = 9):
+        super().__init__(env)
+        self.grid = BinGrid(env.action_space, bins)
+        self.action_space = self.grid.discrete_space
+
+    def action(self, action: np.ndarray) -> np.ndarray:
+        return self.grid.to_continuous(np.asarray(action).reshape(self.grid.action_dims))
+
+
+class ActionPenalty(gym.Wrapper):
+    """Penalize action magnitude: reward ``r - coef * sum(a_norm ** 2)``.
+
+    ``a_norm = 2 (a - low) / (high - low) - 1`` is the action rescaled to ``[-1, 1]``, so the
+    penalty is the paper's ``c_a sum_j (a^j)^2`` on DeepMind Control and comparable across envs.
+    ``info["task_reward"]`` holds the unpenalized reward and ``info["action_penalty"]`` the
+    subtracted amount.
+
+    :param env: env with a finite ``Box`` action space
+    :param coef: penalty coefficient ``c_a`` (the paper uses 0.1 and 0.5)
+    """
+
+    def __init__(self, env: gym.Env, coef: float = 0.1):
+        super().__init__(env)
+        box = check_finite_box(env.action_space, "ActionPenalty (apply it before DiscretizeAction)")
+        if not np.isfinite(coef) or coef < 0:
+            raise ValueError(f"The action penalty coefficient must be finite and >= 0, got {coef}")
+        self.coef = float(coef)
+        self._low = box.low.astype(np.float64)
+        self._high = box.high.astype(np.float64)
+
+    def penalty(self, action: np.ndarray) -> float:
+        """``coef * sum(a_norm ** 2)`` for one action."""
+        normalized = 2.0 * (np.asarray(action, dtype=np.float64) - self._low) / (self._high - self._low) - 1.0
+        return self.coef * float(np.sum(normalized**2))
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        penalty = self.penalty(action)
+        info = dict(info)
+        info["task_reward"] = float(reward)
+        info["action_penalty"] = penalty
+        return obs, float(reward) - penalty, terminated, truncated, info

@@ -1,0 +1,412 @@
+"""Figures of the comparison suite (paper figures 2-4) from ``results.csv`` and the runs' Q-value snapshots."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+import torch as th
+from stable_baselines3.common.callbacks import BaseCallback
+
+from sb3_gqn.experiments.significance import seeded_numpy_global_generator
+
+#: Figure 4's axes: column of results.csv -> label
+RADAR_METRICS = {
+    "task_return": "R",
+    "action_penalty": "P",
+    "action_magnitude": "|a|",
+    "action_change": "|Δa|",
+    "smoothness": "SM",
+}
+RADAR_CAPTION = (
+    "R: task return, 1 + (R - R_ref) / |R_ref| (the ratio when returns are positive; larger is better); "
+    "P: action penalty c·Σa², |a|: mean action magnitude, |Δa|: mean action change "
+    "between steps, SM: smoothness (spectral, higher frequencies weigh more): smaller is smoother. "
+    "The other axes are ratios to the reference agent."
+)
+#: radar ratios above this are drawn at it, with their value written beside the point, so that one agent's
+#: outlier (e.g. decqn-2's action penalty, ~10x the reference's) does not squeeze every other line into the centre
+RADAR_CLIP = 4.0
+RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+RADAR_DASHES = ("-", "--", "-.", ":")
+# Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
+PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
+PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
+
+
+def _slug(text: str) -> str:
+    return text.replace("/", "-").replace(" ", "_")
+
+
+class QValueSnapshots(BaseCallback):
+    """Saves GQN's per-bin utilities over Pendulum's (angle, velocity) grid at the end of every growth level.
+
+    ``q_level<g>.npz`` holds ``utilities`` ``(angles, velocities, max_bins)``, the level's active bins and the grid.
+    """
+
+    def __init__(self, run_dir: Path):
+        super().__init__()
+        self.run_dir = Path(run_dir)
+        self.level = 0
+
+    def _snapshot(self, level: int) -> None:
+        angle, velocity = np.meshgrid(PENDULUM_ANGLES, PENDULUM_VELOCITIES, indexing="ij")
+        observations = np.stack([np.cos(angle), np.sin(angle), velocity], axis=-1).reshape(-1, 3).astype(np.float32)
+        with th.no_grad():
+            utilities = self.model.q_net(th.as_tensor(observations, device=self.model.device))  # type: ignore[attr-defined]
+        utilities = utilities[:, 0, :].cpu().numpy().reshape(len(PENDULUM_ANGLES), len(PENDULUM_VELOCITIES), -1)
+        grid = getattr(self.model, "action_grid", None)
+        np.savez(
+            self.run_dir / f"q_level{level}.npz",
+            utilities=utilities,
+            bin_values=grid.values[0] if grid is not None else np.arange(utilities.shape[-1], dtype=np.float32),
+            active_bins=self.model.bin_levels[level],  # type: ignore[attr-defined]
+            max_bins=self.model.bin_levels[-1],  # type: ignore[attr-defined]
+            angles=PENDULUM_ANGLES,
+            velocities=PENDULUM_VELOCITIES,
+            step=self.num_timesteps,
+        )
+
+    def _on_step(self) -> bool:
+        level = self.model.growth_level  # type: ignore[attr-defined]
+        if level != self.level:  # the network as it was trained at the previous level
+            self._snapshot(self.level)
+            self.level = level
+        return True
+
+    def _on_training_end(self) -> None:
+        self._snapshot(self.model.growth_level)  # type: ignore[attr-defined]
+
+
+def save_q_snapshot(run_dir: Path) -> QValueSnapshots:
+    return QValueSnapshots(run_dir)
+
+
+def mean_curve(runs: pd.DataFrame) -> pd.DataFrame:
+    """One agent's learning curve, per evaluation step: the return's mean, std and run count over seeds, and the
+    *median* training wall time at that step.
+
+    The median, not the mean: a table gathers runs from several invocations, and a minority trained on a loaded or
+    slower machine (2-3x longer with unchanged code happens) would otherwise stretch the agent's whole wall-time
+    curve.
+    """
+    return runs.groupby("step").agg(
+        mean=("return", "mean"), std=("return", "std"), count=("return", "count"), wall=("wall_time", "median")
+    )
+
+
+def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None = None) -> list[Path]:
+    """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band; the wall-time
+    axis places each evaluation at the seeds' median training time (:func:`mean_curve`).
+
+    ``warnings`` (e.g. runs whose budget never reached ``learning_starts``) are printed in red on every figure.
+    """
+    paths = []
+    for (env, penalty), task in table.groupby(["env", "penalty"]):
+        figure, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for index, warning in enumerate(warnings or []):
+            figure.text(
+                0.5,
+                0.5 - 0.08 * index,
+                warning,
+                color="red",
+                ha="center",
+                fontsize=9,
+                bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
+            )
+        for algo, runs in task.groupby("algo"):
+            curve = mean_curve(runs)
+            half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
+            for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
+                seeds = int(curve["count"].max())
+                (line,) = axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})")
+                axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2)
+            _mark_growth_events(axes[0], runs, curve, line.get_color())
+        if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
+            axes[0].plot([], [], "v", color="grey", label="growth (new bin count)")
+        axes[0].set_xlabel("environment steps")
+        axes[1].set_xlabel("training wall time [s], median over seeds")
+        axes[0].set_ylabel("greedy return (penalized)")
+        axes[0].legend(fontsize=8)
+        figure.suptitle(f"{env}, action penalty c = {penalty:g} (mean, 95 % CI over seeds)")
+        figure.tight_layout()
+        path = out / f"learning_curves_{_slug(env)}_c{penalty:g}.png"
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        paths.append(path)
+    return paths
+
+
+def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list[tuple[int, int]]:
+    """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row (``deployments``:
+    the changes of the level its evaluations acted on)."""
+    if column not in runs or runs.empty:
+        return []
+    text = runs.sort_values("step")[column].iloc[-1]
+    if not isinstance(text, str) or not text.strip():
+        return []
+    return [(int(step), int(bins)) for step, bins in (event.split(":") for event in text.split())]
+
+
+def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
+    """A triangle on the algorithm's mean curve at every growth of each of its seeds, labelled with the new bins."""
+    for _, run in runs.groupby("seed"):
+        for step, bins in run_growth_events(run):
+            value = float(np.interp(step, curve.index.to_numpy(), curve["mean"].to_numpy()))
+            axis.plot([step], [value], "v", color=color, markersize=6, markeredgecolor="black", markeredgewidth=0.5)
+            axis.annotate(str(bins), (step, value), textcoords="offset points", xytext=(0, 6), fontsize=6, ha="center")
+
+
+def final_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """The last evaluation of every run."""
+    last = table.groupby(["algo", "env", "penalty", "seed"])["step"].transform("max")
+    return table[table["step"] == last]
+
+
+def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarray]], list[tuple[str, float]]]:
+    """Final returns min-max normalized per task (env, penalty) over all of that task's runs: ``{algo: [runs of
+    each task]}`` (every run, counts may differ between tasks) and the tasks."""
+    final = final_rows(table).copy()
+    task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
+    final = final.join(task_range, on=["env", "penalty"])
+    spread = (final["max"] - final["min"]).replace(0.0, 1.0)
+    final["normalized"] = (final["return"] - final["min"]) / spread
+    final = final.sort_values("seed", kind="stable")  # lowest seeds first, so a cut keeps the same seeds everywhere
+    tasks = sorted(set(zip(final["env"], final["penalty"])))
+    runs_by_algo = {
+        str(algo): [runs[(runs["env"] == env) & (runs["penalty"] == c)]["normalized"].to_numpy() for env, c in tasks]
+        for algo, runs in final.groupby("algo")
+    }
+    return runs_by_algo, tasks
+
+
+def equal_run_scores(runs_by_algo: dict[str, list[np.ndarray]], max_runs: int | None = None) -> dict[str, np.ndarray]:
+    """:func:`normalized_final_runs`' runs as rliable wants them: ``{algo: array (runs, tasks)}``, cut to the
+    algorithm's smallest run count over the tasks (its lowest seeds), and to ``max_runs`` when given (a comparison
+    fixed at a seed count before later seeds ran); an algorithm missing a task is left out."""
+    scores: dict[str, np.ndarray] = {}
+    for algo, per_task in runs_by_algo.items():
+        n_runs = min(len(values) for values in per_task)
+        if max_runs is not None:
+            n_runs = min(n_runs, max_runs)
+        if n_runs:
+            scores[algo] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
+    return scores
+
+
+def normalized_final_scores(
+    table: pd.DataFrame, max_runs: int | None = None
+) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
+    """:func:`normalized_final_runs` cut by :func:`equal_run_scores` (``max_runs``: see there), and the tasks."""
+    runs_by_algo, tasks = normalized_final_runs(table)
+    return equal_run_scores(runs_by_algo, max_runs), tasks
+
+
+def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:
+    """Tasks (env, penalty) whose runs all ended at the same return: their min-max normalization has no range."""
+    task_range = final_rows(table).groupby(["env", "penalty"])["return"].agg(["min", "max"])
+    return [(str(env), float(c)) for (env, c), row in task_range.iterrows() if row["max"] == row["min"]]
+
+
+def iqm_with_intervals(
+    scores: dict[str, np.ndarray], reps: int = 2000, seed: int = 0
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``); ``seed``
+    fixes the bootstrap draws, so that a regenerated table or figure reads the same."""
+    from rliable import library as rly
+    from rliable import metrics as rly_metrics
+
+    with seeded_numpy_global_generator(seed):
+        return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
+
+
+def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None) -> Path:
+    """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs, on at
+    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`)."""
+    scores, tasks = normalized_final_scores(table, max_runs)
+    estimates, intervals = iqm_with_intervals(scores, reps)
+    algos = sorted(scores, key=lambda algo: estimates[algo][0])
+    figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
+    for row, algo in enumerate(algos):
+        low, high = intervals[algo][:, 0]
+        axis.barh(row, high - low, left=low, height=0.6, alpha=0.6)
+        axis.plot([estimates[algo][0]] * 2, [row - 0.3, row + 0.3], color="black")
+        runs = int(scores[algo].shape[0])
+        if runs == 1:  # one run per task: no interval to draw, say so instead of showing an empty row
+            axis.annotate(
+                "1 run per task: no CI", (high, row), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7
+            )
+    lows = [intervals[algo][0, 0] for algo in algos]
+    highs = [intervals[algo][1, 0] for algo in algos]
+    axis.set_xlim(min(lows) - 0.05, max(highs) + 0.2)  # room for the estimate at an interval's edge and the note
+    axis.set_yticks(range(len(algos)), algos)
+    axis.set_xlabel("IQM of normalized final return (95 % bootstrap CI)")
+    names = [f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks]
+    axis.set_title(f"{len(tasks)} task{'s' if len(tasks) != 1 else ''}: " + textwrap.fill(", ".join(names), 90), fontsize=8)
+    degenerate = degenerate_tasks(table)
+    if degenerate:  # every run of the task ended at the same return: min-max normalization scores them all 0
+        listed = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in degenerate)
+        note = f"Normalization degenerate (all final returns equal, all scored 0) on: {listed}"
+        figure.text(0.5, 0.01, textwrap.fill(note, 90), color="red", ha="center", va="bottom", fontsize=7)
+        figure.tight_layout(rect=(0, 0.12, 1, 1))
+    else:
+        figure.tight_layout()
+    path = out / "aggregate_iqm.png"
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+    return path
+
+
+def _reference(final: pd.DataFrame) -> tuple[str, float] | None:
+    """Figure 4's reference: GQN without penalty (adaptive, else linear), else at the smallest penalty run."""
+    for algo in ("gqn-adaptive", "gqn-linear", *sorted(final["algo"].unique())):
+        runs = final[final["algo"] == algo]
+        if len(runs):
+            return algo, float(runs["penalty"].min())
+    return None
+
+
+def clipped_radii(ratios: np.ndarray, clip: float = RADAR_CLIP) -> tuple[np.ndarray, np.ndarray]:
+    """The radar's radii for ``ratios``: each ratio, or ``clip`` where it is larger, and which ones were clipped.
+
+    ``[0.5, 4.0, 10.2]`` with ``clip=4`` is drawn at ``[0.5, 4.0, 4.0]``, the last marked clipped.
+    """
+    ratios = np.asarray(ratios, dtype=np.float64)
+    clipped = ratios > clip
+    return np.where(clipped, clip, ratios), clipped
+
+
+def return_radius(returns: np.ndarray, reference: float) -> np.ndarray:
+    """The radar's R for task ``returns`` against the reference agent's: ``1 + (R - R_ref) / |R_ref|``, at least 0.
+
+    With a positive reference this is the ratio ``R / R_ref`` (800 against 400: 2.0). With a negative one (Pendulum)
+    a plain ratio would grow as the return gets worse; this keeps larger better: -200 against -100 is 0 (twice the
+    cost), -50 against -100 is 1.5, 0 against -100 is 2. A zero reference has no scale: NaN.
+    """
+    returns = np.asarray(returns, dtype=np.float64)
+    if reference == 0.0 or not np.isfinite(reference):
+        return np.full_like(returns, np.nan)
+    return np.maximum(1.0 + (returns - reference) / abs(reference), 0.0)
+
+
+def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
+    """Figure 4 per env: R, P, |a|, |Δa|, SM of the final policies relative to the reference agent."""
+    paths = []
+    for env, runs in final_rows(table).groupby("env"):
+        reference = _reference(runs)
+        if reference is None:
+            continue
+        means = runs.groupby(["algo", "penalty"])[list(RADAR_METRICS)].mean()
+        base = means.loc[reference].replace(0.0, np.nan)
+        angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
+        figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
+        any_clipped = False
+        for index, ((algo, penalty), values) in enumerate(means.iterrows()):
+            relative = (values / base).abs()
+            relative["task_return"] = return_radius(np.array([values["task_return"]]), float(base["task_return"]))[0]
+            relative = relative.fillna(0.0).to_numpy()
+            radii, clipped = clipped_radii(relative)
+            closed = np.append(radii, radii[0])
+            # markers and dash patterns tell apart lines that coincide (e.g. two agents that are both bang-bang)
+            [line] = axis.plot(
+                np.append(angles, angles[0]),
+                closed,
+                label=f"{algo} c={penalty:g}",
+                marker=RADAR_MARKERS[index % len(RADAR_MARKERS)],
+                linestyle=RADAR_DASHES[index % len(RADAR_DASHES)],
+                markersize=6,
+                alpha=0.85,
+            )
+            for angle, ratio in zip(angles[clipped], relative[clipped]):
+                axis.annotate(
+                    f"{ratio:.1f}x",
+                    (angle, RADAR_CLIP),
+                    xytext=(4, 4 + 9 * (index % 3)),
+                    color=line.get_color(),
+                    textcoords="offset points",
+                    fontsize=7,
+                )
+            any_clipped = any_clipped or bool(clipped.any())
+        if any_clipped:
+            axis.set_ylim(0, RADAR_CLIP * 1.05)
+        axis.set_xticks(angles, list(RADAR_METRICS.values()))
+        axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g} (= 1)", fontsize=9)
+        axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.2))
+        caption = RADAR_CAPTION + (
+            f" Ratios above {RADAR_CLIP:g} are drawn at {RADAR_CLIP:g}, their value beside them." if any_clipped else ""
+        )
+        figure.text(0.5, 0.01, textwrap.fill(caption, 105), ha="center", va="bottom", fontsize=7)
+        figure.tight_layout(rect=(0, 0.07, 1, 1))
+        path = out / f"smoothness_radar_{_slug(env)}.png"
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        paths.append(path)
+    return paths
+
+
+def q_value_picture(run_dir: Path, out: Path) -> Path | None:
+    """Figure 2: per-bin utilities over Pendulum's (angle, velocity) grid at each growth level, active bins outlined."""
+    snapshots = sorted(run_dir.glob("q_level*.npz"), key=lambda path: int(path.stem.removeprefix("q_level")))
+    if not snapshots:
+        return None
+    loaded: list[Any] = [np.load(path) for path in snapshots]
+    max_bins = int(loaded[0]["max_bins"])
+    bin_values = loaded[0].get("bin_values")  # older snapshots lack them
+    figure, axes = plt.subplots(
+        len(loaded), max_bins, figsize=(1.35 * max_bins + 1.2, 1.5 * len(loaded) + 1.0), squeeze=False, layout="constrained"
+    )
+    for row, snapshot in enumerate(loaded):
+        utilities, active = snapshot["utilities"], int(snapshot["active_bins"])
+        active_indices = set(np.linspace(0, max_bins - 1, active).round().astype(int).tolist())
+        low, high = np.percentile(utilities, [2, 98])
+        angles, velocities = snapshot["angles"], snapshot["velocities"]
+        extent = (velocities[0], velocities[-1], angles[0], angles[-1])
+        for column in range(max_bins):
+            axis = axes[row, column]
+            image = axis.imshow(utilities[:, :, column], origin="lower", aspect="auto", extent=extent, vmin=low, vmax=high)
+            axis.set_xticks([velocities[0], 0, velocities[-1]] if row == len(loaded) - 1 else [])
+            axis.set_yticks([angles[0], 0, angles[-1]] if column == 0 else [])
+            axis.tick_params(labelsize=6)
+            if column == 0:
+                axis.set_yticklabels(["-π", "0", "π"])
+            for spine in axis.spines.values():
+                spine.set_linewidth(2.5 if column in active_indices else 0.5)
+                spine.set_color("red" if column in active_indices else "grey")
+            if row == 0:
+                value = f"\na = {bin_values[column]:+.2f}" if bin_values is not None else ""
+                axis.set_title(f"bin {column}{value}", fontsize=7)
+        axes[row, 0].set_ylabel(f"{active} bins, step {int(snapshot['step'])}\nangle [rad]", fontsize=7)
+        colorbar = figure.colorbar(image, ax=axes[row, :].tolist(), shrink=0.9, pad=0.01)
+        colorbar.ax.tick_params(labelsize=6)
+        colorbar.set_label("utility Q(s, bin)", fontsize=7)
+    for axis in axes[-1, :]:
+        axis.set_xlabel("velocity [rad/s]", fontsize=6)
+    figure.suptitle(
+        f"{run_dir.name}: per-bin utilities over angle x angular velocity at the end of each level "
+        "(a: the bin's torque; red frame: active bins; colour scale per row)",
+        fontsize=8,
+    )
+    path = out / f"q_values_{run_dir.name}.png"
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+    return path
+
+
+def plot_suite(table_path: Path, out: Path, warnings: list[str] | None = None) -> list[Path]:
+    """All figures for a results table; returns the written paths (``warnings``: see :func:`learning_curves`)."""
+    table = pd.read_csv(table_path)
+    if table.empty:
+        return []
+    paths = [*learning_curves(table, out, warnings), aggregate(table, out), *smoothness_radar(table, out)]
+    for run_dir in sorted((out / "runs").glob("*")):
+        picture = q_value_picture(run_dir, out)
+        if picture is not None:
+            paths.append(picture)
+    return paths

@@ -1,0 +1,190 @@
+"""The project's main job: train GQN on a penalized DeepMind Control task and write its results.
+
+    sb3-gqn reference-run                       # cartpole-swingup, c = 0.1, the gqn.yml entry's arguments
+    sb3-gqn reference-run --timesteps 20000 --out /tmp/smoke
+
+Writes to <out>/<run name>/: learning_curve.csv (greedy evaluation every --eval-freq steps: return, task
+return, action cost, SM, active bins, training seconds), learning_curve.png, final_evaluation.json (the
+final greedy episodes, wall time, env steps/s), SB3's progress.csv and the trained model.zip.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import platform
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+os.environ.setdefault("MUJOCO_GL", "disable")  # no rendering: keep dm_control off any GL backend
+
+import torch as th
+from stable_baselines3.common.logger import configure
+from stable_baselines3.common.monitor import Monitor
+
+from sb3_gqn import GQN, DecQN, __version__
+from sb3_gqn.common.envs import make_env
+from sb3_gqn.common.evaluation import LearningCurveCallback, evaluate
+from sb3_gqn.zoo.hyperparams import HYPERPARAMS_DIR, constructor_arguments, read_entries
+
+
+def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--env", default="dm_control/cartpole-swingup-v0", help="gymnasium env id")
+    parser.add_argument("--penalty", type=float, default=0.1, help="action penalty coefficient c (0 for none)")
+    parser.add_argument("--algo", choices=["gqn", "decqn"], default="gqn")
+    parser.add_argument("--bins", type=int, nargs="+", default=[2, 9], help="initial and final bins (one int: static)")
+    parser.add_argument("--growth", default="adaptive", choices=["adaptive", "linear", "none"])
+    parser.add_argument("--timesteps", type=int, default=None, help="default: the env's n_timesteps in --hyperparams")
+    parser.add_argument(
+        "--hyperparams",
+        default=str(HYPERPARAMS_DIR / "gqn.yml"),
+        help="rl-zoo3-style file whose entry for --env supplies GQN arguments (train_freq, bins, ...)",
+    )
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")
+    parser.add_argument("--eval-episodes", type=int, default=5, help="episodes per learning-curve evaluation")
+    parser.add_argument("--final-episodes", type=int, default=10, help="episodes of the final evaluation")
+    parser.add_argument("--out", default="results", help="output folder")
+    parser.add_argument("--verbose", type=int, default=1)
+    return parser.parse_args(argv)
+
+
+def load_hyperparams(path: str, env_id: str) -> dict[str, Any]:
+    """GQN constructor arguments and ``n_timesteps`` of ``env_id``'s entry in an rl-zoo3-style YAML file ({} if the
+    file or the entry is absent); ``bins`` and ``growth`` come from the command line, the env is built here."""
+    if not Path(path).is_file():
+        return {}
+    entry = read_entries(path).get(env_id, {})
+    arguments = constructor_arguments({key: value for key, value in entry.items() if key not in ("bins", "growth")})
+    if "n_timesteps" in entry:
+        arguments["n_timesteps"] = entry["n_timesteps"]
+    return arguments
+
+
+def run_name(args: argparse.Namespace) -> str:
+    env = args.env.split("/")[-1].removesuffix("-v0").removesuffix("-v1")
+    bins = "-".join(str(b) for b in args.bins)
+    growth = f"_{args.growth}" if args.algo == "gqn" and len(args.bins) > 1 else ""
+    return f"{args.algo}{growth}_bins{bins}_{env}_p{args.penalty:g}_seed{args.seed}"
+
+
+def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def plot_learning_curve(
+    path: Path,
+    rows: list[dict[str, Any]],
+    title: str,
+    growth_events: list[tuple[int, int]],
+    deployments: list[tuple[int, int]] | None = None,
+) -> None:
+    """Greedy return and task return over env steps; a dotted line at every growth event, and with
+    ``growth_probation`` a dashed one where ``predict`` moved to the opened level (``deployments``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    steps = [row["step"] for row in rows]
+    figure, axis = plt.subplots(figsize=(6.4, 4.0))
+    axis.plot(steps, [row["return_"] for row in rows], marker="o", label="return (penalized)")
+    axis.plot(steps, [row["task_return"] for row in rows], marker=".", linestyle="--", label="task return")
+    for step, bins in growth_events:
+        axis.axvline(step, color="grey", alpha=0.4, linestyle=":")
+        axis.annotate(f"-> {bins} bins", (step, axis.get_ylim()[0]), rotation=90, fontsize=7, va="bottom")
+    if deployments is not None and list(deployments) != list(growth_events):
+        for step, bins in deployments:
+            axis.axvline(step, color="tab:green", alpha=0.5, linestyle="--")
+            axis.annotate(f"predict {bins}", (step, axis.get_ylim()[1]), rotation=90, fontsize=7, va="top")
+    axis.set_xlabel("environment steps")
+    axis.set_ylabel("episode return (greedy)")
+    axis.set_title(title, fontsize=9)
+    axis.grid(alpha=0.3)
+    axis.legend(loc="upper left")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
+    """Train, evaluate and write the run described by ``args`` (see :func:`parse_args`); return the summary that
+    ``final_evaluation.json`` holds."""
+    hyperparams = load_hyperparams(args.hyperparams, args.env)
+    n_timesteps = int(hyperparams.pop("n_timesteps", 100_000))
+    args.timesteps = args.timesteps or n_timesteps
+    out = Path(args.out) / run_name(args)
+    out.mkdir(parents=True, exist_ok=True)
+    bins: int | tuple[int, int] = args.bins[0] if len(args.bins) == 1 else (args.bins[0], args.bins[1])
+
+    env = Monitor(make_env(args.env, action_penalty=args.penalty))
+    eval_env = make_env(args.env, action_penalty=args.penalty)
+    eval_seed = args.seed + 10_000  # evaluation episodes' initial states follow the seed too
+    common = dict(seed=args.seed, verbose=0, **hyperparams)
+    if args.algo == "decqn":
+        model: GQN = DecQN("MlpPolicy", env, bins=int(args.bins[-1]), **common)
+    else:
+        growth = None if args.growth == "none" else args.growth
+        model = GQN("MlpPolicy", env, bins=bins, growth=growth, **common)
+    model.verbose = args.verbose  # growth events on the console
+    model.set_logger(configure(str(out), ["csv"]))  # SB3's training log to progress.csv instead of console tables
+
+    curve = LearningCurveCallback(
+        eval_env, eval_freq=args.eval_freq, n_episodes=args.eval_episodes, seed=eval_seed, verbose=args.verbose
+    )
+    started = time.perf_counter()
+    model.learn(args.timesteps, callback=curve)
+    wall_seconds = time.perf_counter() - started
+    final = evaluate(model, eval_env, n_episodes=args.final_episodes, seed=eval_seed + 1_000)
+
+    model.save(out / "model.zip")
+    write_csv(out / "learning_curve.csv", curve.rows)
+    plot_learning_curve(
+        out / "learning_curve.png",
+        curve.rows,
+        f"{run_name(args)} (sb3-gqn {__version__})",
+        list(model.growth_events),
+        list(model.deployments),
+    )
+    summary = {
+        "run": run_name(args),
+        "args": vars(args),
+        "hyperparams": {key: str(value) for key, value in hyperparams.items()},
+        "timesteps": model.num_timesteps,
+        "gradient_steps": model._n_updates,
+        "wall_seconds": wall_seconds,
+        "train_seconds": curve.rows[-1]["train_seconds"] if curve.rows else wall_seconds,
+        "env_steps_per_second": model.num_timesteps / wall_seconds,
+        "final_active_bins": model.active_bins,
+        "growth_events": [{"step": step, "active_bins": bins} for step, bins in model.growth_events],
+        "deployments": [{"step": step, "deployed_bins": bins} for step, bins in model.deployments],
+        "final_evaluation": final.as_dict(),
+        "machine": {"python": platform.python_version(), "torch": th.__version__, "threads": th.get_num_threads()},
+    }
+    with open(out / "final_evaluation.json", "w") as handle:
+        json.dump(summary, handle, indent=2)
+    if args.verbose:
+        print(
+            f"final: return {final.return_mean:.1f} +- {final.return_std:.1f}, task return {final.task_return_mean:.1f}, "
+            f"{model.active_bins} bins, {wall_seconds:.0f}s wall -> {out}"
+        )
+    return summary
+
+
+def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn reference-run") -> int:
+    """``sb3-gqn reference-run``: returns the exit code."""
+    train_and_evaluate(parse_args(argv, prog))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

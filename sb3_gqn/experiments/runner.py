@@ -1,0 +1,157 @@
+"""Comparison suite: GQN vs DecQN vs SAC/TD3 on penalized envs, in parallel, resumable, one tidy table and plots.
+
+    sb3-gqn benchmark                       # short suite: Pendulum-v1, c = 0.1 (~3 min on 2 cores)
+    sb3-gqn benchmark --algos gqn-adaptive sac --envs dm_control/cartpole-swingup-v0 \\
+        --penalties 0.1 --seeds 0 1 --steps 100000 --out results/cartpole
+    sb3-gqn benchmark --full --list         # the paper-scale suite (list the runs only)
+    sb3-gqn benchmark --full --ray-address auto --threads 1 --out results/full   # on a Ray cluster
+
+Each run trains through the project's rl-zoo3 integration (ExperimentManager with the shipped
+hyperparameter file of its algorithm, the penalty set in the entry's ActionPenalty wrapper and the
+budget given here), evaluates greedily every --eval-freq steps with sb3_gqn.common.evaluation.rollout_figures
+and writes <out>/runs/<run>/curve.csv; done.json marks it finished. Runs go to parallel
+processes (--jobs, default the core count, torch threads split between them). A second invocation
+skips finished runs (a done.json, or the run's rows up to its budget in <out>/results.csv, so a
+committed table can be extended by a later invocation) and restarts interrupted ones from scratch. At the
+end <out>/results.csv holds every evaluation of every run of the suite (algo, env, penalty, seed, step,
+return, task return, wall time, smoothness figures, growth events) and sb3_gqn.experiments.plots draws the figures into <out>/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoCo off any GL backend
+
+from sb3_gqn.experiments.processes import run_in_processes
+from sb3_gqn.experiments.runs import collect, is_finished, progress_line, recorded_rows, run
+from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, VARIANTS, RunSpec, load_variants, untrained_runs
+from sb3_gqn.zoo.hyperparams import penalized_env_ids
+
+
+def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> argparse.Namespace:
+    variants_parser = argparse.ArgumentParser(add_help=False)
+    variants_parser.add_argument(
+        "--variants",
+        nargs="+",
+        type=Path,
+        default=[],
+        metavar="FILE",
+        help="variants files (YAML, see sb3_gqn.experiments.variants) whose agents --algos may name besides the shipped "
+        "ones, e.g. docs/research/variants.yml",
+    )
+    known, _ = variants_parser.parse_known_args(argv)
+    for path in known.variants:
+        load_variants(path)
+    parser = argparse.ArgumentParser(
+        prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter, parents=[variants_parser]
+    )
+    parser.add_argument(
+        "--algos",
+        nargs="+",
+        choices=list(VARIANTS),
+        metavar="AGENT",
+        help=f"agents: {', '.join(VARIANTS)} (default: {' '.join(SHORT_SUITE['algos'])})",
+    )
+    parser.add_argument("--envs", nargs="+", help=f"env ids with an entry in the shipped files; default {SHORT_SUITE['envs']}")
+    parser.add_argument("--penalties", nargs="+", type=float, help="action penalty coefficients c")
+    parser.add_argument("--seeds", nargs="+", type=int)
+    parser.add_argument("--steps", type=int, help="env steps per run (the same for every algorithm)")
+    parser.add_argument("--full", action="store_true", help="paper-scale defaults (many machine-days)")
+    parser.add_argument("--eval-freq", type=int, help="env steps between evaluations (default: steps / 10)")
+    parser.add_argument("--eval-episodes", type=int, default=3, help="greedy episodes per evaluation")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
+    parser.add_argument(
+        "--threads", type=int, help="torch threads per run (default: cores / jobs; lower it when other work shares the cores)"
+    )
+    parser.add_argument("--out", default="results/benchmark", help="output folder")
+    parser.add_argument(
+        "--ray-address",
+        help="run every run as a task on this Ray cluster ('auto': the cluster this process runs in; needs the ray extra); "
+        "the driver alone writes --out",
+    )
+    parser.add_argument("--ray-gpus", type=float, default=0.0, help="GPU fraction each Ray task reserves (default 0)")
+    parser.add_argument("--ray-retries", type=int, default=3, help="retries of a run whose worker or node dies (default 3)")
+    parser.add_argument("--list", action="store_true", help="list the runs and their state, train nothing")
+    parser.add_argument("--no-plots", action="store_true")
+    args = parser.parse_args(argv)
+    defaults = FULL_SUITE if args.full else SHORT_SUITE
+    for key in ("algos", "envs", "penalties", "seeds", "steps"):
+        if getattr(args, key) is None:
+            setattr(args, key, defaults[key])
+    if args.eval_freq is None:
+        args.eval_freq = max(args.steps // 10, 1)
+    return args
+
+
+def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> int:
+    args = parse_args(argv, prog)
+    known = penalized_env_ids()
+    unknown = [env for env in args.envs if env not in known]
+    if unknown:
+        print(f"{prog}: error: no hyperparameter entry for {unknown} (known: {known})", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    specs = [
+        RunSpec(algo, env, penalty, seed, args.steps)
+        for env in args.envs
+        for penalty in args.penalties
+        for algo in args.algos
+        for seed in args.seeds
+    ]
+    recorded = recorded_rows(out / "results.csv")
+    pending = [spec for spec in specs if not is_finished(spec, out, recorded)]
+    print(f"{len(specs)} runs, {len(specs) - len(pending)} already finished, {len(pending)} to train -> {out}")
+    warnings = untrained_runs(specs)
+    for warning in warnings:
+        print(f"WARNING: {warning}: raise --steps", file=sys.stderr)
+    if args.list:
+        for spec in specs:
+            print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
+        return 0
+    jobs = max(1, min(args.jobs, len(pending) or 1))
+    threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)
+    if pending and args.ray_address:
+        from sb3_gqn.experiments.ray_runner import run_on_ray
+
+        out.mkdir(parents=True, exist_ok=True)
+        run_on_ray(
+            pending,
+            specs,
+            out,
+            recorded,
+            address=args.ray_address,
+            eval_freq=args.eval_freq,
+            eval_episodes=args.eval_episodes,
+            threads=args.threads or 1,
+            gpus=args.ray_gpus,
+            retries=args.ray_retries,
+        )
+    elif pending:
+        out.mkdir(parents=True, exist_ok=True)
+        by_name = {spec.name: spec for spec in pending}
+        run_in_processes(
+            [(spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads)) for spec in pending],
+            jobs,
+            on_finished=lambda name: print(f"finished {name}"),
+            on_wait=lambda names: print(
+                progress_line(specs, out, {name: by_name[name] for name in names if (out / "runs" / name).exists()}, recorded),
+                flush=True,
+            ),
+        )
+    table = collect(specs, out)
+    print(f"results table: {table}")
+    if not args.no_plots:
+        from sb3_gqn.experiments.plots import plot_suite
+
+        for path in plot_suite(table, out, warnings):
+            print(f"plot: {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,229 @@
+"""One run of the comparison suite, and the suite's table: train and evaluate a run (:func:`run`), find the runs a
+table or an earlier invocation finished (:func:`recorded_rows`, :func:`is_finished`) and write ``results.csv``
+(:func:`collect`). The local runner (:mod:`~sb3_gqn.experiments.runner`) and the Ray runner
+(:mod:`~sb3_gqn.experiments.ray_runner`) both train through :func:`run`."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from filelock import FileLock
+
+from sb3_gqn.common.evaluation import LearningCurveCallback
+from sb3_gqn.experiments.variants import RunSpec, make_eval_env, penalized_wrappers, run_overrides
+from sb3_gqn.zoo.hyperparams import shipped_entry, shipped_hyperparams
+
+#: Columns of results.csv, in order
+COLUMNS = [
+    "algo",
+    "env",
+    "penalty",
+    "seed",
+    "step",
+    "return",
+    "task_return",
+    "action_penalty",
+    "action_magnitude",
+    "action_change",
+    "smoothness",
+    "smoothness_freq",
+    "episode_length",
+    "active_bins",
+    "wall_time",
+    "growth_events",
+    "deployed_bins",
+    "deployments",
+]
+
+
+def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
+    """One ``results.csv`` row (:data:`COLUMNS`): run ``spec``'s learning-curve row (see
+    :class:`~sb3_gqn.common.evaluation.LearningCurveCallback`) under the table's column names."""
+    return {
+        "algo": spec.algo,
+        "env": spec.env,
+        "penalty": spec.penalty,
+        "seed": spec.seed,
+        "step": row["step"],
+        "return": row["return_"],
+        "task_return": row["task_return"],
+        "action_penalty": row["penalty"],
+        "action_magnitude": row["action_magnitude"],
+        "action_change": row["action_change"],
+        "smoothness": row["smoothness"],
+        "smoothness_freq": row["freq"],
+        "episode_length": row["episode_length"],
+        "active_bins": row["active_bins"],
+        "wall_time": row["train_seconds"],
+        "growth_events": row["growth_events"],
+        "deployed_bins": row["deployed_bins"],
+        "deployments": row["deployments"],
+    }
+
+
+def append_row(path: Path, row: dict[str, Any]) -> None:
+    """Append one :data:`COLUMNS` row to the csv file ``path`` (with the header when the file is new)."""
+    with open(path, "a", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+        if handle.tell() == 0:
+            writer.writeheader()
+        writer.writerow(row)
+
+
+def run(
+    spec: RunSpec,
+    out: Path,
+    eval_freq: int,
+    eval_episodes: int,
+    threads: int,
+    report_progress: Callable[[int], None] | None = None,
+) -> str:
+    """Train and evaluate one run in this process; return its name. Skips a finished run.
+
+    ``report_progress`` (optional) is called with the run's env steps every 500 steps (the Ray runner
+    forwards them to the driver; locally the driver reads ``runs/<run>/progress``).
+    """
+    run_dir = out / "runs" / spec.name
+    if (run_dir / "done.json").is_file():
+        return spec.name
+    if run_dir.exists():  # interrupted earlier: start again from scratch
+        shutil.rmtree(run_dir)
+    run_dir.mkdir(parents=True)
+    import torch as th
+    from rl_zoo3.exp_manager import ExperimentManager
+
+    from sb3_gqn.experiments.plots import save_q_snapshot
+    from sb3_gqn.zoo.registration import register
+
+    th.set_num_threads(threads)
+    register()
+    zoo_algo, overrides = run_overrides(spec)
+    wrappers = penalized_wrappers(shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
+    manager = ExperimentManager(
+        argparse.Namespace(),
+        zoo_algo,
+        spec.env,
+        str(run_dir / "zoo"),
+        n_timesteps=spec.steps,
+        eval_freq=-1,
+        hyperparams={**overrides, "env_wrapper": wrappers},
+        seed=spec.seed,
+        verbose=0,
+        log_interval=-1,
+        config=str(shipped_hyperparams(zoo_algo)),
+    )
+    model, _ = manager.setup_experiment()  # type: ignore[misc]
+    eval_env = make_eval_env(spec)
+
+    def on_progress(steps: int) -> None:
+        (run_dir / "progress").write_text(str(steps))
+        if report_progress is not None:
+            report_progress(steps)
+
+    curve = LearningCurveCallback(
+        eval_env,
+        eval_freq,
+        eval_episodes,
+        seed=10_000 + spec.seed,
+        on_row=lambda row: append_row(run_dir / "curve.csv", curve_row(spec, row)),
+        on_progress=on_progress,
+    )
+    manager.callbacks.append(curve)
+    if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
+        manager.callbacks.append(save_q_snapshot(run_dir))
+    started = time.perf_counter()
+    manager.learn(model)
+    model.save(run_dir / "model.zip")
+    summary = {"run": spec.name, "spec": asdict(spec), "wall_seconds": time.perf_counter() - started, "threads": threads}
+    (run_dir / "done.json.tmp").write_text(json.dumps(summary, indent=2))
+    os.replace(run_dir / "done.json.tmp", run_dir / "done.json")
+    return spec.name
+
+
+#: rows of a results.csv grouped by run key (algo, env, penalty, seed)
+RecordedRuns = dict[tuple[str, str, float, int], list[dict[str, Any]]]
+
+
+def _run_key(row: dict[str, Any]) -> tuple[str, str, float, int]:
+    return str(row["algo"]), str(row["env"]), float(row["penalty"]), int(float(row["seed"]))
+
+
+def recorded_rows(table: Path) -> RecordedRuns:
+    """Rows of an existing ``results.csv`` grouped by run (algo, env, penalty, seed); empty if there is none.
+
+    Committed tables are how a later invocation (or another machine) extends a suite: a run recorded there up to its
+    budget counts as finished even when its ``runs/`` folder is gone.
+    """
+    if not table.is_file():
+        return {}
+    runs: RecordedRuns = {}
+    with open(table, newline="") as handle:
+        for row in csv.DictReader(handle):
+            runs.setdefault(_run_key(row), []).append(row)
+    return runs
+
+
+def is_recorded(spec: RunSpec, recorded: RecordedRuns) -> bool:
+    """Whether ``results.csv`` holds ``spec`` evaluated up to its full budget."""
+    rows = recorded.get(spec.key, [])
+    return any(int(float(row["step"])) >= spec.steps for row in rows)
+
+
+def is_finished(spec: RunSpec, out: Path, recorded: RecordedRuns) -> bool:
+    return (out / "runs" / spec.name / "done.json").is_file() or is_recorded(spec, recorded)
+
+
+def collect(specs: list[RunSpec], out: Path) -> Path:
+    """Write ``<out>/results.csv``: the suite's finished curves, plus every run an earlier table recorded.
+
+    A run finished in ``runs/`` replaces its earlier rows; runs of other invocations are kept, so
+    invocations with different algorithms or seeds accumulate into one table. Invocations that share
+    ``out`` and finish together take turns: the read-modify-write holds an exclusive lock on
+    ``<out>/results.csv.lock``, so neither writes a table that lacks the other's runs.
+    """
+    table = out / "results.csv"
+    with FileLock(out / "results.csv.lock"):
+        rows_by_run = recorded_rows(table)
+        for spec in specs:
+            curve = out / "runs" / spec.name / "curve.csv"
+            if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
+                with open(curve, newline="") as rows:
+                    rows_by_run[spec.key] = list(csv.DictReader(rows))
+        scratch = table.with_suffix(f".csv.{os.getpid()}.tmp")
+        with open(scratch, "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
+            writer.writeheader()
+            for key in sorted(rows_by_run, key=lambda key: (key[1], key[2], key[0], key[3])):
+                writer.writerows({column: row.get(column, "") for column in COLUMNS} for row in rows_by_run[key])
+        os.replace(scratch, table)
+    return table
+
+
+def progress_line(
+    specs: list[RunSpec],
+    out: Path,
+    running: dict[str, RunSpec],
+    recorded: RecordedRuns,
+    steps_by_run: dict[str, int] | None = None,
+) -> str:
+    """One progress line: runs done / total, then each running run's steps (from ``steps_by_run`` when given,
+    else from the run folder's ``progress`` file)."""
+    done = sum(is_finished(spec, out, recorded) for spec in specs)
+    parts = [f"[{done}/{len(specs)} runs done]"]
+    for name, spec in running.items():
+        if steps_by_run is not None:
+            steps = str(steps_by_run.get(name, 0))
+        else:
+            progress = out / "runs" / name / "progress"
+            steps = progress.read_text() if progress.is_file() else "0"
+        parts.append(f"{name}: {steps}/{spec.steps} steps")
+    return "  ".join(parts)

@@ -1,0 +1,67 @@
+"""The callback that applies a model's growth schedule during ``learn()`` (GQN installs it itself)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from stable_baselines3.common.callbacks import BaseCallback
+
+from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth, linear_growth_level
+
+if TYPE_CHECKING:
+    from sb3_gqn.gqn.gqn import GQN
+
+
+class GrowthCallback(BaseCallback):
+    """Applies the model's growth schedule after every environment step (installed by ``GQN.learn``).
+
+    :param env_was_reset: whether ``learn()`` reset the environment (episodes in progress are lost)
+    """
+
+    model: GQN
+
+    def __init__(self, env_was_reset: bool = True, verbose: int = 0):
+        super().__init__(verbose)
+        self.env_was_reset = env_was_reset
+
+    def _on_training_start(self) -> None:
+        schedule = self.model.growth_schedule
+        if isinstance(schedule, AdaptiveGrowth):
+            schedule.start(self.model.n_envs, self.env_was_reset, self.model.num_timesteps)
+        self.model.logger.record("growth/active_bins", self.model.active_bins)
+
+    def _on_step(self) -> bool:
+        model = self.model
+        last_level = len(model.bin_levels) - 1
+        if model.growth is None:
+            return True
+        if model.growth == "linear":
+            target = linear_growth_level(model.num_timesteps, model._total_timesteps, len(model.bin_levels))
+            if target > model.growth_level:
+                model.grow(target, reason=f"linear schedule at step {model.num_timesteps}")
+            return True
+        schedule = model.growth_schedule
+        assert isinstance(schedule, AdaptiveGrowth), "growth='adaptive' always has its AdaptiveGrowth state"
+        if model.growth_level >= last_level and not schedule.on_probation:
+            return True
+        rewards = self.locals["rewards"]
+        if model._vec_normalize_env is not None:
+            rewards = model._vec_normalize_env.get_original_reward()
+        for decision in schedule.observe(rewards, self.locals["dones"], model.num_timesteps):
+            model.logger.record("growth/return", decision.current_return)
+            if decision.threshold is not None:
+                model.logger.record("growth/threshold", decision.threshold)
+            if decision.probation_reference is not None:
+                model.logger.record("growth/probation_return", decision.current_return)
+            if decision.deploy:
+                model.deploy(reason=f"{decision.describe_probation()} at step {model.num_timesteps}")
+            if decision.grow and model.growth_level < last_level:
+                schedule.start_probation(decision.current_return)
+                model.grow(
+                    model.growth_level + 1,
+                    reason=f"{schedule.returns_source} {decision.describe()} at step {model.num_timesteps}",
+                    probation=schedule.on_probation,
+                )
+            if model.growth_level >= last_level and not schedule.on_probation:
+                schedule.stop_evaluating()
+        return True

@@ -1,0 +1,131 @@
+"""The model's control resolution: which nested level of bins it learns and explores (the growth level) and which
+one it acts on (the deployed level), and the two moves between levels, :meth:`~GrowingResolution.grow` and
+:meth:`~GrowingResolution.deploy` (paper section 3.2, with the warm start ``growth_init`` and the probation
+``growth_probation``).
+
+:class:`GrowingResolution` is a mixin of :class:`~sb3_gqn.gqn.gqn.GQN`: its state lives on the model (``growth_level``,
+``growth_events``, ``deployments``, ``_deployed_level``, saved with it) and the model's constructor sets it;
+``sb3_gqn.gqn.growth.schedules`` decides *when* to grow, this module does it.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import torch as th
+
+from sb3_gqn.common.masking import active_bin_indices, active_bin_mask
+from sb3_gqn.gqn.growth.schedules import interpolation_neighbours
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth
+    from sb3_gqn.gqn.policies import GQNPolicy
+
+
+class GrowingResolution:
+    """Growth level, deployed level and the moves between them, for a model with a :class:`~sb3_gqn.gqn.policies.GQNPolicy`
+    (``policy``) over the nested levels ``bin_levels``."""
+
+    bin_levels: list[int]
+    growth_level: int
+    growth_init: str
+    growth_events: list[tuple[int, int]]
+    deployments: list[tuple[int, int]]
+    _deployed_level: int | None  # the level predict() acts on while an opened level is on probation; None: growth level
+    growth_schedule: AdaptiveGrowth | None
+    policy: GQNPolicy
+    num_timesteps: int
+    verbose: int
+    _active_bin_indices: np.ndarray
+    _learning_bins_mask: th.Tensor
+
+    @property
+    def active_bins(self) -> int:
+        """Current resolution: number of active bins per action dimension (the level learned and explored)."""
+        return self.bin_levels[self.growth_level]
+
+    @property
+    def deployed_level(self) -> int:
+        """The level ``predict`` acts on: :attr:`growth_level`, or the previous one while an opened level is on
+        probation (``growth_probation``)."""
+        return self.growth_level if self._deployed_level is None else self._deployed_level
+
+    @property
+    def deployed_bins(self) -> int:
+        """Bins per action dimension ``predict`` (and evaluation, export) chooses from."""
+        return self.bin_levels[self.deployed_level]
+
+    def _apply_growth_level(self) -> None:
+        """Point the masks and the exploration's choices at the current levels: exploration and the probation
+        episodes' greedy actions use the growth level; the policy's mask (greedy actions, ``predict``, the TD
+        target's max) the deployed one."""
+        max_bins = self.bin_levels[-1]
+        self._active_bin_indices = active_bin_indices(max_bins, self.active_bins)
+        self.policy.set_active_mask(active_bin_mask(max_bins, self.deployed_bins))
+        self._learning_bins_mask = th.as_tensor(active_bin_mask(max_bins, self.active_bins), device=self.policy.device)
+
+    def _record_levels(self, *keys: str) -> None:
+        """Log the levels under ``growth/<key>`` (no logger before the first ``learn()``)."""
+        if getattr(self, "_logger", None) is None:
+            return
+        values = {
+            "active_bins": self.active_bins,
+            "deployed_bins": self.deployed_bins,
+            "level": self.growth_level,
+            "last_growth_step": self.num_timesteps,
+        }
+        for key in keys:
+            self.logger.record(f"growth/{key}", values[key])  # type: ignore[attr-defined]
+
+    def grow(self, level: int | None = None, reason: str = "manual", probation: bool = False) -> None:
+        """Open resolution level ``level`` (default: the next one) for every action dimension.
+
+        Called by the growth callback; can also be called by hand. Levels never shrink.
+
+        :param level: index into :attr:`bin_levels`
+        :param reason: text for the log and the console (``verbose >= 1``)
+        :param probation: keep ``predict`` on the deployed level until :meth:`deploy` (the adaptive schedule's
+            probation); by hand (``False``) the level is deployed at once, ending any running probation
+        """
+        level = self.growth_level + 1 if level is None else int(level)
+        if not self.growth_level <= level < len(self.bin_levels):
+            raise ValueError(f"Cannot grow from level {self.growth_level} to {level} (levels: {self.bin_levels})")
+        if level == self.growth_level:
+            return
+        previous_bins = self.active_bins
+        if self.growth_init == "interpolate":
+            # One nested step at a time, so a jump over several levels interpolates from already warm bins
+            for step_level in range(self.growth_level + 1, level + 1):
+                self.policy.interpolate_bins(
+                    interpolation_neighbours(self.bin_levels[-1], self.bin_levels[step_level - 1], self.bin_levels[step_level])
+                )
+        deployed_level = self.deployed_level
+        self.growth_level = level
+        if probation:
+            self._deployed_level = deployed_level
+        else:
+            self._deployed_level = None
+            if self.growth_schedule is not None:
+                self.growth_schedule.end_probation()
+        self._apply_growth_level()
+        self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
+        if not probation:
+            self.deployments.append((int(self.num_timesteps), int(self.active_bins)))
+        self._record_levels("active_bins", "deployed_bins", "level", "last_growth_step")
+        if self.verbose >= 1:
+            on_probation = f"; predict stays at {self.deployed_bins} bins on probation" if probation else ""
+            print(f"GQN growth: {previous_bins} -> {self.active_bins} bins per dimension ({reason}{on_probation})")
+
+    def deploy(self, reason: str = "manual") -> None:
+        """Let ``predict`` act on the growth level (ends a probation; nothing to do without one)."""
+        if self._deployed_level is None:
+            return
+        previous_bins = self.deployed_bins
+        self._deployed_level = None
+        self._apply_growth_level()
+        self.deployments.append((int(self.num_timesteps), int(self.deployed_bins)))
+        self._record_levels("deployed_bins")
+        if self.verbose >= 1:
+            print(f"GQN deployed: predict acts on {previous_bins} -> {self.deployed_bins} bins per dimension ({reason})")

@@ -1,0 +1,347 @@
+"""When to open the next, finer level of nested bins (paper section 4).
+
+* :func:`nested_bin_levels` lists the resolutions ``2 -> 3 -> 5 -> 9`` (each level doubles the
+  number of intervals between the action bounds).
+* ``growth="linear"``: :func:`linear_growth_level` opens level ``g`` (0-based, level 0 is
+  active from the start) once ``g / (N + 1)`` of the total timesteps have passed, ``N`` being the
+  number of levels.
+* ``growth="adaptive"``: :class:`AdaptiveGrowth` keeps a moving window of returns and grows when
+  the current return falls below the threshold of paper eq. 4 (:func:`adaptive_threshold`), or when
+  the returns have stopped improving (:func:`plateau`, which eq. 4 cannot see: a flat return has
+  ``sigma = 0`` and never falls below ``0.95 mu``).
+* ``growth_init="interpolate"``: :func:`interpolation_neighbours` says which two active bins each
+  newly opened bin is warm-started from.
+* ``growth_probation`` (adaptive growth): a level the schedule opens is explored at once, but the agent keeps
+  acting greedily and bootstrapping on the deployed level until a greedy episode over the new one holds the return
+  (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
+
+:class:`~sb3_gqn.gqn.growth.callback.GrowthCallback` drives either schedule during ``learn()``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sb3_gqn.common.arguments import check_choice, check_int, check_number
+
+GROWTH_SCHEDULES = ("adaptive", "linear", None)
+GROWTH_INITS = ("interpolate", "none")
+RETURN_SOURCES = ("evaluation", "training")
+
+
+def nested_bin_levels(initial: int, final: int) -> list[int]:
+    """The nested resolutions from ``initial`` to ``final`` bins per dimension.
+
+    Each level doubles the number of intervals: ``n -> 2 n - 1``. ``(2, 9)`` gives
+    ``[2, 3, 5, 9]``, ``(9, 65)`` gives ``[9, 17, 33, 65]``, ``(3, 9)`` gives ``[3, 5, 9]``,
+    ``(9, 9)`` gives ``[9]``.
+
+    :raises ValueError: if ``final`` cannot be reached by doubling from ``initial``
+        (e.g. ``(2, 8)`` or ``(4, 9)``), or either is below 2
+    """
+    for name, value in (("initial", initial), ("final", final)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise TypeError(f"bins must be integers, got {name}={value!r}")
+    initial, final = int(initial), int(final)
+    if initial < 2:
+        raise ValueError(f"The coarsest level needs at least 2 bins per dimension, got {initial}")
+    if final < initial:
+        raise ValueError(f"bins=({initial}, {final}): the final resolution must not be below the initial one")
+    levels = [initial]
+    while levels[-1] < final:
+        levels.append(2 * levels[-1] - 1)
+    if levels[-1] != final:
+        raise ValueError(
+            f"bins=({initial}, {final}) cannot be nested: doubling the intervals from {initial} bins gives "
+            f"{levels[:-1]} then {levels[-1]}, never {final}. Valid pairs are e.g. (2, 9), (3, 9), (9, 65)."
+        )
+    return levels
+
+
+def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
+    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`)."""
+    if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
+        return nested_bin_levels(int(bins), int(bins))
+    if isinstance(bins, (tuple, list)) and len(bins) == 2:
+        return nested_bin_levels(bins[0], bins[1])
+    raise TypeError(f"bins must be an int or an (initial, final) pair, got {bins!r}")
+
+
+def adaptive_threshold(mean: float, std: float) -> float:
+    """Paper eq. 4: ``(1 - 0.05 sgn(mu)) mu + 0.9 sigma``.
+
+    ``mean`` and ``std`` are the moving-window mean and standard deviation of past returns;
+    growth happens when the current return falls below this value (stagnation).
+    """
+    return (1.0 - 0.05 * float(np.sign(mean))) * mean + 0.9 * std
+
+
+def plateau(returns: list[float], patience: int, min_improvement: float = 0.05) -> bool:
+    """Patience rule: the last ``patience`` returns did not improve on the best return before them.
+
+    An improvement must exceed ``min_improvement * |best|`` (5 % by default, the margin eq. 4 uses), so
+    evaluation noise around a flat return does not count as progress. Needs ``patience + 1`` returns.
+    ``[-1000, -1000, -1000]`` with ``patience=2`` is a plateau; ``[10, 50, 52]`` is one (52 < 50 * 1.05);
+    ``[10, 50, 60]`` is not.
+
+    :param returns: returns since the last growth, oldest first
+    :param patience: evaluations without improvement before the rule fires
+    :param min_improvement: relative margin an improvement must exceed
+    """
+    if patience < 1 or len(returns) < patience + 1:
+        return False
+    best_before = max(returns[:-patience])
+    return max(returns[-patience:]) <= best_before + min_improvement * abs(best_before)
+
+
+def probation_holds(reference: float, candidate: float, tolerance: float = 0.3) -> bool:
+    """Whether a greedy return at a newly opened level holds the deployed level's: ``candidate`` is at least
+    ``reference - tolerance * |reference|`` (70 % of a positive reference by default, 130 % of a negative one).
+
+    ``probation_holds(300, 210)`` is True, ``(300, 209)`` False, ``(-100, -130)`` True, ``(-100, -131)`` False,
+    ``(45, 0)`` False (a policy that stands still after earning 45), ``(0, 0)`` True.
+
+    :param reference: the deployed level's last greedy return (the one the growth was decided on)
+    :param candidate: a greedy return over the opened level
+    :param tolerance: the relative drop that still holds
+    """
+    return candidate >= reference - tolerance * abs(reference)
+
+
+def interpolation_neighbours(max_bins: int, previous_bins: int, active_bins: int) -> list[tuple[int, int, int]]:
+    """The bins one growth step opens, each with its two nested neighbours: ``(new, left, right)``.
+
+    Opening level ``active_bins`` from ``previous_bins`` (one doubling) halves the stride between active
+    bins; each new bin sits midway between two previously active ones. With 9 bins: 2 -> 3 opens bin 4
+    between 0 and 8; 3 -> 5 opens 2 (0, 4) and 6 (4, 8).
+
+    :raises ValueError: if ``active_bins`` is not the next nested level after ``previous_bins``
+    """
+    if active_bins != 2 * previous_bins - 1 or (max_bins - 1) % (active_bins - 1) != 0:
+        raise ValueError(f"{previous_bins} -> {active_bins} bins (of {max_bins}) is not one nested growth step")
+    stride = (max_bins - 1) // (active_bins - 1)
+    return [(new, new - stride, new + stride) for new in range(stride, max_bins - 1, 2 * stride)]
+
+
+def linear_growth_level(num_timesteps: int, total_timesteps: int, n_levels: int) -> int:
+    """Level index the linear schedule has reached: level ``g`` opens at ``g / (N + 1)`` of training.
+
+    With ``N = 4`` levels and 100 000 total steps, levels 1, 2, 3 open at 20 000, 40 000, 60 000.
+    """
+    if total_timesteps <= 0:
+        return 0
+    reached = math.floor(num_timesteps * (n_levels + 1) / total_timesteps)
+    return max(0, min(n_levels - 1, reached))
+
+
+@dataclass
+class GrowthDecision:
+    """Outcome of one adaptive check: the compared return, the eq. 4 threshold (None while the window
+    fills), when ``grow`` which rule fired (``"eq. 4"`` or ``"plateau"``), and when the return was a probation
+    return (``probation_reference`` set) whether the opened level is deployed."""
+
+    current_return: float
+    threshold: float | None
+    window_mean: float | None
+    window_std: float | None
+    grow: bool
+    rule: str | None = None
+    deploy: bool = False
+    probation_reference: float | None = None
+
+    def describe(self) -> str:
+        """One line for the console and the log."""
+        if self.rule == "plateau":
+            return f"return {self.current_return:.2f} stopped improving (plateau)"
+        return f"return {self.current_return:.2f} < eq. 4 threshold {self.threshold:.2f}"
+
+    def describe_probation(self) -> str:
+        """One line for a probation return: held, or deployed after the last allowed try."""
+        held = "holds" if probation_holds(self.probation_reference, self.current_return) else "misses, last try"  # type: ignore[arg-type]
+        return f"probation return {self.current_return:.2f} {held} against {self.probation_reference:.2f}"
+
+
+@dataclass
+class AdaptiveGrowth:
+    """State of the adaptive schedule (saved with the model).
+
+    Returns come either from greedy evaluation episodes (``returns_source="evaluation"``) or from
+    every finished training episode (``"training"``). Evaluation episodes are interleaved with
+    training: every ``eval_freq`` environment steps, the next ``eval_episodes`` episodes that start
+    act greedily over the active bins (no epsilon). Their transitions still go to the replay buffer
+    and count as environment steps, so no separate evaluation env or extra budget is needed, and it
+    works for any env, wrapper stack or VecEnv that GQN trains on.
+
+    Two rules decide, after every return, whether the next level opens:
+
+    * eq. 4 (:func:`adaptive_threshold`): the window holds the last ``window`` returns since the most
+      recent growth; once it is full, a return below the threshold grows;
+    * the plateau rule (:func:`plateau`): ``patience`` returns in a row without a ``min_improvement``
+      gain on the best return of the level grow. ``patience=None`` leaves eq. 4 alone (the paper as
+      written).
+
+    After a growth both restart, so the new level is judged on its own returns and one dip cannot
+    cascade through all levels.
+
+    With ``probation`` (an int), an opened level is explored at once, but greedy actions and the TD target's max
+    stay on the deployed level (the opened bins learn "this bin, then the deployed policy"): the evaluation
+    episodes, which act greedily over the opened level, are its probation. The first whose return holds against
+    the deployed level's last return (:func:`probation_holds`), or the ``probation``-th in any case, deploys it. A
+    level opened at the first decision that can grow is deployed one evaluation later if it holds. The growth rules
+    read the evaluation returns as without probation. With ``returns_source="training"`` no episode acts greedily
+    over the opened level, so the first training return that holds deploys it (usually the next one).
+
+    :param eval_freq: environment steps between evaluations
+    :param eval_episodes: greedy episodes averaged into one evaluation return
+    :param window: number of past returns in the moving mean and standard deviation
+    :param returns_source: ``"evaluation"`` or ``"training"``
+    :param patience: returns without improvement before the plateau rule grows (``None``: off)
+    :param min_improvement: relative gain that counts as an improvement for the plateau rule
+    :param probation: evaluations over an opened level before it is deployed even if none held (``None``: deploy
+        at opening, the paper as written)
+    """
+
+    eval_freq: int = 2_500
+    eval_episodes: int = 1
+    window: int = 3
+    returns_source: str = "evaluation"
+    patience: int | None = 2
+    min_improvement: float = 0.05
+    probation: int | None = None
+    probation_reference: float | None = None
+    probation_tries: int = 0
+    history: list[float] = field(default_factory=list)
+    level_returns: list[float] = field(default_factory=list)
+    next_eval_step: int = 0
+    pending_episodes: int = 0
+    finished_eval_returns: list[float] = field(default_factory=list)
+    greedy_envs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    episode_returns: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __post_init__(self) -> None:
+        # The constructor's own checks (sb3_gqn.common.arguments), under the names GQN's arguments carry
+        check_choice("growth_returns", self.returns_source, RETURN_SOURCES)
+        self.eval_freq = check_int("growth_eval_freq", self.eval_freq, 1)
+        self.eval_episodes = check_int("growth_eval_episodes", self.eval_episodes, 1)
+        self.window = check_int("growth_window", self.window, 1)
+        if self.patience is not None:
+            self.patience = check_int("growth_patience", self.patience, 1)
+        self.min_improvement = check_number("growth_min_improvement", self.min_improvement, 0.0)
+        if self.probation is not None:
+            self.probation = check_int("growth_probation", self.probation, 1)
+        if self.next_eval_step == 0:
+            self.next_eval_step = self.eval_freq
+
+    def __setstate__(self, state: dict) -> None:
+        # Models saved before the plateau rule existed: eq. 4 alone, the level's returns start from the window
+        state.setdefault("patience", None)
+        state.setdefault("min_improvement", 0.05)
+        state.setdefault("level_returns", list(state.get("history", [])))
+        # Models saved before probation existed: deployed at opening, as they were trained
+        state.setdefault("probation", None)
+        state.setdefault("probation_reference", None)
+        state.setdefault("probation_tries", 0)
+        self.__dict__.update(state)
+
+    @property
+    def on_probation(self) -> bool:
+        """Whether an opened level waits to be deployed."""
+        return self.probation_reference is not None
+
+    def start(self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0) -> None:
+        """Prepare per-env bookkeeping at the start of ``learn()``.
+
+        When the env was reset (new run, ``set_env``, load), the episodes in progress are gone: their
+        partial returns are dropped and greedy evaluation episodes that were running are started again.
+        A run whose step counter was reset (``reset_num_timesteps=True``) evaluates ``eval_freq`` steps on.
+        """
+        if self.next_eval_step > num_timesteps + self.eval_freq:
+            self.next_eval_step = num_timesteps + self.eval_freq
+        if env_was_reset or len(self.greedy_envs) != n_envs:
+            self.pending_episodes += int(self.greedy_envs.sum())
+            self.greedy_envs = np.zeros(n_envs, dtype=bool)
+            self.episode_returns = np.zeros(n_envs, dtype=np.float64)
+            for env_idx in range(n_envs):
+                self._start_episode(env_idx)
+
+    def _start_episode(self, env_idx: int) -> None:
+        if self.pending_episodes > 0:
+            self.greedy_envs[env_idx] = True
+            self.pending_episodes -= 1
+
+    def observe(self, rewards: np.ndarray, dones: np.ndarray, num_timesteps: int) -> list[GrowthDecision]:
+        """Account one vectorised env step; return the decisions made at episodes that just ended."""
+        evaluating = self.returns_source == "evaluation"
+        if evaluating and num_timesteps >= self.next_eval_step:
+            self.next_eval_step = (num_timesteps // self.eval_freq + 1) * self.eval_freq
+            if self.pending_episodes == 0 and not self.greedy_envs.any() and not self.finished_eval_returns:
+                self.pending_episodes = self.eval_episodes
+        self.episode_returns += rewards
+        decisions = []
+        for env_idx in np.flatnonzero(dones):
+            episode_return = float(self.episode_returns[env_idx])
+            self.episode_returns[env_idx] = 0.0
+            if not evaluating:
+                decisions.append(self.decide(episode_return))
+            elif self.greedy_envs[env_idx]:
+                self.greedy_envs[env_idx] = False
+                self.finished_eval_returns.append(episode_return)
+                if len(self.finished_eval_returns) == self.eval_episodes:
+                    decisions.append(self.decide(float(np.mean(self.finished_eval_returns))))
+                    self.finished_eval_returns = []
+            self._start_episode(int(env_idx))
+        return decisions
+
+    def decide(self, current_return: float) -> GrowthDecision:
+        """Apply eq. 4 over the window and the plateau rule over the level's returns; grow if either fires.
+
+        While a level is on probation the return is also its probation return: ``deploy`` when it holds or the
+        tries are used up. The growth rules are the same with or without probation; a growth that happens starts
+        its probation through :meth:`start_probation`.
+        """
+        deploy, reference = False, self.probation_reference
+        if reference is not None:
+            self.probation_tries += 1
+            deploy = probation_holds(reference, current_return) or self.probation_tries >= (self.probation or 1)
+            if deploy:
+                self.probation_reference, self.probation_tries = None, 0
+        self.level_returns.append(current_return)
+        threshold = window_mean = window_std = None
+        rule = None
+        if len(self.history) >= self.window:
+            window_mean = float(np.mean(self.history))
+            window_std = float(np.std(self.history))
+            threshold = adaptive_threshold(window_mean, window_std)
+            if current_return < threshold:
+                rule = "eq. 4"
+        if rule is None and self.patience is not None and plateau(self.level_returns, self.patience, self.min_improvement):
+            rule = "plateau"
+        if rule is not None:
+            self.history = []
+            self.level_returns = []
+        else:
+            self.history = [*self.history, current_return][-self.window :]
+        return GrowthDecision(
+            current_return, threshold, window_mean, window_std, grow=rule is not None, rule=rule, deploy=deploy,
+            probation_reference=reference,
+        )  # fmt: skip
+
+    def start_probation(self, reference: float) -> None:
+        """A level was opened after a decision on ``reference`` (the deployed level's return): its probation starts,
+        unless an earlier opened level is still on probation (then that one's reference and tries carry on, and the
+        first return that holds deploys both)."""
+        if self.probation is not None and self.probation_reference is None:
+            self.probation_reference, self.probation_tries = float(reference), 0
+
+    def end_probation(self) -> None:
+        """Forget a running probation (the level was deployed by other means, e.g. ``model.grow()`` by hand)."""
+        self.probation_reference, self.probation_tries = None, 0
+
+    def stop_evaluating(self) -> None:
+        """No further levels: stop scheduling greedy episodes."""
+        self.pending_episodes = 0
+        self.finished_eval_returns = []
+        self.greedy_envs[:] = False

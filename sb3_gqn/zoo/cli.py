@@ -1,0 +1,170 @@
+"""rl-zoo3's ``train``, ``enjoy`` and ``record_video`` with ``gqn`` and ``decqn`` registered and the project's
+hyperparameter files as defaults (``sb3-gqn train|enjoy|record-video``).
+
+    sb3-gqn train --algo gqn --env dm_control/cartpole-swingup-v0
+    sb3-gqn train --algo sac --env Pendulum-v1 -n 20000 --seed 1 -f logs
+    sb3-gqn train --algo gqn --env Pendulum-v1 -optimize --n-trials 20 --storage postgresql://...
+    sb3-gqn enjoy --algo gqn --env dm_control/cartpole-swingup-v0 -f logs --no-render -n 5000
+
+Every rl-zoo3 flag works, plus ``--n-envs N`` (short for ``-params n_envs:N``). Without ``-conf`` the algorithms the
+project ships a file for (gqn, decqn, sac, td3) read ``sb3_gqn/zoo/hyperparams/<algo>.yml``; the others read
+rl-zoo3's own files. ``-optimize`` without ``--storage`` keeps the study in ``<log folder>/<algo>/optuna.db``
+(SQLite) under the name ``<algo>_<env>``. ``enjoy`` and ``record_video`` load the agent without a replay buffer
+(``buffer_size=1``). ``MUJOCO_GL`` defaults to ``disable`` for training (it renders nothing).
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+import sys
+import traceback
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from sb3_gqn.zoo.hyperparams import shipped_hyperparams
+from sb3_gqn.zoo.registration import ZOO_ALGOS, loader_without_replay_memory, register
+
+
+def _option_value(argv: Sequence[str], *names: str) -> str | None:
+    """The value of the last ``--name value`` or ``--name=value`` in ``argv``."""
+    value = None
+    for position, argument in enumerate(argv):
+        for name in names:
+            if argument == name and position + 1 < len(argv):
+                value = argv[position + 1]
+            elif argument.startswith(name + "="):
+                value = argument.split("=", 1)[1]
+    return value
+
+
+def default_train_arguments(argv: Sequence[str]) -> list[str]:
+    """rl-zoo3 train arguments with the project's defaults added where the user gave none:
+
+    - ``--conf-file hyperparams/<algo>.yml`` for the algorithms the project ships a file for;
+    - with ``-optimize``: an SQLite storage ``<log folder>/<algo>/optuna.db`` and the study name
+      ``<algo>_<env>``, so that an interrupted study resumes and ``--trial-id`` can load from it;
+    - ``--n-envs N``, which rl-zoo3 reads only from the hyperparameters, becomes ``-params n_envs:N``.
+    """
+    argv = _n_envs_as_hyperparameter(list(argv))
+    algo = _option_value(argv, "--algo") or "ppo"
+    config = shipped_hyperparams(algo)
+    if config is not None and _option_value(argv, "-conf", "--conf-file") is None:
+        argv += ["--conf-file", str(config)]
+    if "-optimize" in argv or "--optimize-hyperparameters" in argv:
+        env_id = _option_value(argv, "--env") or "CartPole-v1"
+        if _option_value(argv, "--storage") is None:
+            log_folder = Path(_option_value(argv, "-f", "--log-folder") or "logs") / algo
+            log_folder.mkdir(parents=True, exist_ok=True)
+            argv += ["--storage", f"sqlite:///{log_folder.resolve() / 'optuna.db'}"]
+        if _option_value(argv, "--study-name") is None:
+            argv += ["--study-name", f"{algo}_{env_id.replace('/', '-')}"]
+    return argv
+
+
+def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
+    n_envs = _option_value(argv, "--n-envs")
+    if n_envs is None:
+        return argv
+    kept: list[str] = []
+    skip_next = False
+    for argument in argv:
+        if skip_next:
+            skip_next = False
+        elif argument == "--n-envs":
+            skip_next = True
+        elif not argument.startswith("--n-envs="):
+            kept.append(argument)
+    for position, argument in enumerate(kept):
+        if argument in ("-params", "--hyperparams"):  # one StoreDict group: later groups would replace it
+            return [*kept[: position + 1], f"n_envs:{int(n_envs)}", *kept[position + 1 :]]
+    return [*kept, "-params", f"n_envs:{int(n_envs)}"]
+
+
+MISSING_ENTRY_HINT = """\
+This env has no entry in the hyperparameter file. Write one (rl-zoo3's YAML format) and pass the file with
+-conf my_hyperparams.yml, e.g. for a torque-controlled task:
+
+my-env-v0:
+  n_timesteps: !!float 2e5
+  policy: 'MlpPolicy'
+  bins: [2, 9]          # 9 -> 65 for velocity control
+  growth: 'adaptive'
+  train_freq: 2
+  env_wrapper:
+    - sb3_gqn.common.wrappers.ActionPenalty:
+        coef: 0.1
+
+How to choose bins, growth, the penalty and train_freq: README, "Train GQN on your own task"."""
+
+
+def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
+    """Run an rl-zoo3 entry point on ``argv`` with the project's algorithms registered.
+
+    Errors become one line on stderr and exit code 1 (set ``SB3_GQN_TRACEBACK=1`` for the traceback);
+    argparse's own usage errors keep their exit code 2.
+    """
+    saved_argv = sys.argv
+    sys.argv = [prog, *(sys.argv[1:] if argv is None else argv)]
+    try:
+        entry_point()
+    except SystemExit as exit_:
+        return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 1)
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as error:
+        if os.environ.get("SB3_GQN_TRACEBACK"):
+            traceback.print_exc()
+        message = str(error).strip().splitlines()[0] if str(error).strip() else ""
+        print(f"{prog}: error: {type(error).__name__}: {message}", file=sys.stderr)
+        if message.startswith("Hyperparameters not found"):
+            print(MISSING_ENTRY_HINT, file=sys.stderr)
+        return 1
+    finally:
+        sys.argv = saved_argv
+    return 0
+
+
+def _train() -> None:
+    from rl_zoo3.train import train as zoo_train
+
+    sys.argv = [sys.argv[0], *default_train_arguments(sys.argv[1:])]
+    zoo_train()
+
+
+def _enjoy() -> None:
+    from rl_zoo3.enjoy import enjoy as zoo_enjoy
+
+    zoo_enjoy()
+
+
+def _record_video() -> None:
+    # rl-zoo3 runs this script's body under __main__; it is executed the same way, after registration
+    runpy.run_module("rl_zoo3.record_video", run_name="__main__", alter_sys=False)
+
+
+def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
+    """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
+    os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
+    register()
+    return run_cli(_train, argv, prog=prog)
+
+
+def _replay(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
+    register()
+    from rl_zoo3 import utils
+
+    utils.ALGOS.update({name: loader_without_replay_memory(algo) for name, algo in ZOO_ALGOS.items()})
+    return run_cli(entry_point, argv, prog=prog)
+
+
+def enjoy(argv: Sequence[str] | None = None, prog: str = "sb3-gqn enjoy") -> int:
+    """rl-zoo3's enjoy (replay and evaluate a trained agent); returns the exit code."""
+    return _replay(_enjoy, argv, prog)
+
+
+def record_video(argv: Sequence[str] | None = None, prog: str = "sb3-gqn record-video") -> int:
+    """rl-zoo3's record_video; returns the exit code."""
+    return _replay(_record_video, argv, prog)

@@ -1,0 +1,48 @@
+"""GQN and DecQN in rl-zoo3's registries.
+
+rl-zoo3 has no plugin mechanism: its ``ALGOS`` dict and the Optuna ``HYPERPARAMS_SAMPLER`` /
+``HYPERPARAMS_CONVERTER`` dicts are read when its argument parsers and experiment manager run.
+:func:`register` fills them in place, so every rl-zoo3 entry point called afterwards in the same
+process (``sb3-gqn train``, ``sb3-gqn enjoy``, ``sb3-gqn record-video``) knows ``gqn`` and ``decqn`` next to
+rl-zoo3's own algorithms.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sb3_gqn.common.envs import register_envs
+from sb3_gqn.decqn.decqn import DecQN
+from sb3_gqn.gqn.gqn import GQN
+
+#: The project's algorithms under their rl-zoo3 names
+ZOO_ALGOS: dict[str, type[GQN]] = {"gqn": GQN, "decqn": DecQN}
+
+
+def register() -> None:
+    """Put ``gqn`` and ``decqn`` into rl-zoo3's ``ALGOS``, Optuna samplers and converters, and register the suites'
+    env ids (idempotent)."""
+    from rl_zoo3 import hyperparams_opt, utils
+
+    from sb3_gqn.zoo.tuning import convert_gqn_params, sample_decqn_params, sample_gqn_params
+
+    utils.ALGOS.update(ZOO_ALGOS)
+    hyperparams_opt.HYPERPARAMS_SAMPLER.update({"gqn": sample_gqn_params, "decqn": sample_decqn_params})
+    hyperparams_opt.HYPERPARAMS_CONVERTER.update({"gqn": convert_gqn_params, "decqn": convert_gqn_params})
+    register_envs()
+
+
+def loader_without_replay_memory(algo_class: type[GQN]) -> type[GQN]:
+    """``algo_class`` whose ``load`` defaults to ``buffer_size=1``: replaying an agent needs no replay memory.
+
+    rl-zoo3's enjoy and record_video do this only for their own off-policy algorithms.
+    """
+
+    class Loader(algo_class):  # type: ignore[valid-type, misc]
+        @classmethod
+        def load(cls, path: Any, *args: Any, **kwargs: Any) -> GQN:  # type: ignore[override]
+            kwargs.setdefault("buffer_size", 1)
+            return algo_class.load(path, *args, **kwargs)
+
+    Loader.__name__ = Loader.__qualname__ = algo_class.__name__
+    return Loader
