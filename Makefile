@@ -4,11 +4,11 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv results test test-slow lint benchmark readme-tables constraints clean
+.PHONY: venv results test test-slow lint docs benchmark readme-tables constraints clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[all,tests]"
+	$(BIN)/pip install --quiet --disable-pip-version-check -c constraints.txt -e ".[all,tests,docs]"
 	touch $@
 
 venv: $(VENV)/.installed
@@ -29,6 +29,10 @@ test: venv lint
 test-slow: venv
 	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)
 
+# The API documentation (Sphinx, from the docstrings) into docs/_build/html; warnings are errors
+docs: venv
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+
 benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
@@ -40,8 +44,8 @@ readme-tables: venv
 # Re-pin the whole dependency set from a fresh environment
 constraints:
 	rm -rf /tmp/sb3-gqn-constraints && $(PYTHON) -m venv /tmp/sb3-gqn-constraints
-	/tmp/sb3-gqn-constraints/bin/pip install --quiet -c constraints.txt ".[all,tests]"
+	/tmp/sb3-gqn-constraints/bin/pip install --quiet -c constraints.txt ".[all,tests,docs]"
 	/tmp/sb3-gqn-constraints/bin/pip freeze | grep -v '^sb3-gqn' | sed 's/+cpu$$//'
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache build *.egg-info
+	rm -rf $(VENV) .pytest_cache .ruff_cache build *.egg-info docs/_build

@@ -113,7 +113,7 @@ class SmoothnessFigures:
 
     ``task_return`` R (without the action penalty), ``penalty`` P (the action cost ``sum_t sum_j a_j^2``
     of the rescaled actions, i.e. the penalty with ``c = 1``; the reward lost to an ``ActionPenalty(c)``
-    is ``c * P``), ``action_magnitude`` |a| (mean of ``|a_j|``), ``action_change`` |Δa| (mean of
+    is ``c * P``), ``action_magnitude`` ``|a|`` (mean of ``|a_j|``), ``action_change`` ``|Δa|`` (mean of
     ``|a_j(t) - a_j(t-1)|``), ``smoothness`` SM (:func:`smoothness` per episode), ``return_`` the
     return the agent was trained on (penalized if the env is), and the sampling frequency used.
     """

@@ -297,7 +297,7 @@ def return_radius(returns: np.ndarray, reference: float) -> np.ndarray:
 
 
 def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Figure 4 per env: R, P, |a|, |Δa|, SM of the final policies relative to the reference agent."""
+    """Figure 4 per env: R, P, ``|a|``, ``|Δa|``, SM of the final policies relative to the reference agent."""
     paths = []
     for env, runs in final_rows(table).groupby("env"):
         reference = _reference(runs)
