@@ -6,7 +6,8 @@
     export_onnx(model, "policy.onnx")                       # onnxruntime.InferenceSession("policy.onnx")
     export_onnx(model, "policy.onnx", vec_normalize=stats)  # with VecNormalize's observation statistics
 
-The file holds the online network, the current active-bin mask and the bin grid (see
+The file holds the network ``predict`` acts on (the Polyak average of the online network with ``acting_tau``, the
+online network without), the current active-bin mask and the bin grid (see
 :class:`~sb3_gqn.export.policy.DeployedPolicy`): it returns the env's action (continuous values for a
 ``Box`` env, bin indices for ``Discrete``/``MultiDiscrete``) for a batch of observations, greedily, and matches
 ``model.predict(obs, deterministic=True)``. Export again after the model grows: the mask is baked in.
