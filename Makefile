@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv results test test-slow lint docs benchmark readme-tables constraints clean
+.PHONY: venv results test test-slow lint docs benchmark results-page constraints clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -37,9 +37,10 @@ benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
 
-# The results report's generated blocks (docs/results/README.md) and docs/results/main's figures, from the committed docs/results tables
-readme-tables: venv
-	$(BIN)/python docs/results/readme_tables.py
+# The results page (docs/results/README.md), the README's results table and docs/results/main's figures, from the
+# committed docs/results tables
+results-page: venv
+	$(BIN)/python docs/results/build.py
 
 # Re-pin the whole dependency set from a fresh environment
 constraints:

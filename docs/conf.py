@@ -36,7 +36,7 @@ extensions = [
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 # results/ and research/ hold the results report and the research notes: plain Markdown read on the repository,
-# not pages of this site (the results page links to them)
+# not pages of this site (the results page points to them)
 exclude_patterns = ["_build", "results", "research", "Thumbs.db", ".DS_Store"]
 
 # Unresolvable references to third-party classes (torch, gymnasium, SB3) in signatures are not errors

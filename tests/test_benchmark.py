@@ -205,21 +205,21 @@ def trained(algo: str, env: str) -> dict:
     return {**shipped_entry(zoo_algo, env), **overrides}
 
 
-def readme_tables():
-    """docs/results/readme_tables.py (a script, not a module of the package)."""
-    spec = importlib.util.spec_from_file_location("readme_tables", Path(__file__).parents[1] / "docs/results/readme_tables.py")
+def results_page():
+    """docs/results/build.py (a script, not a module of the package)."""
+    spec = importlib.util.spec_from_file_location("results_page", Path(__file__).parents[1] / "docs/results/build.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
 def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants():
-    """sb3_gqn.experiments.report's --shipped (and docs/results/readme_tables.py) report these variants' walker and finger runs
+    """sb3_gqn.experiments.report's --shipped (and docs/results/build.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
     residual torso, by rule R1; finger: DecQN's default torso)."""
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
-    assert {walker: "+residual+1update", finger: "+layernorm+1update"} == readme_tables().SHIPPED
+    assert {walker: "+residual+1update", finger: "+layernorm+1update"} == results_page().SHIPPED
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         assert trained(algo, walker) == trained(f"{algo}+residual+1update", walker)
         assert trained(algo, finger) == trained(f"{algo}+layernorm+1update", finger)
@@ -256,15 +256,14 @@ def test_the_torso_variants_differ_from_the_entries_only_in_the_torso():
             assert candidate["policy_kwargs"] == torso
 
 
-def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_compare_probes_with_the_entry_before():
+def test_the_results_page_refuses_a_shipped_entry_without_every_agents_runs():
     """A task's shipped variant must have run on every seed an earlier entry ran, for every agent of the main
     comparison: otherwise the first entry's runs would stay in the tables under the plain name, mixed with the shipped
-    ones, or the tables would lose seeds. A probe is compared with the task's shipped entry, or with the entry before
-    it when it is the shipped one."""
+    ones, or the tables would lose seeds."""
     import pandas as pd
 
-    tables = readme_tables()
-    walker, cartpole = "dm_control/walker-walk-v0", "dm_control/cartpole-swingup-v0"
+    tables = results_page()
+    walker = "dm_control/walker-walk-v0"
     suffix = tables.SHIPPED[walker]
     runs = [(agent, seed) for agent in tables.MAIN_ALGOS for seed in (0, 1)]
     first_entry = pd.DataFrame([{"algo": agent, "env": walker, "seed": seed, "return": 1.0} for agent, seed in runs])
@@ -274,64 +273,21 @@ def test_the_readme_tables_refuse_a_shipped_entry_without_every_agents_runs_and_
     with pytest.raises(SystemExit, match=re.escape(f"decqn-9{suffix} (the shipped entry) lacks seeds [1]")):
         tables.shipped(pd.concat([first_entry, shipped.iloc[:-1]], ignore_index=True))
 
-    assert tables.entry_before(walker, "+residual+1update") == "+layernorm+1update"  # the shipped entry: the one before
-    assert tables.entry_before(walker, "+layernorm+1update") == "+residual+1update"
-    assert tables.entry_before("dm_control/finger-spin-v0", "+layernorm+1update") == ""
-    assert tables.entry_before(cartpole, "+residual") == ""
 
-
-def test_item_5_compares_each_probe_with_the_entry_on_that_probes_seeds_only():
-    """Finger's shipped entry is compared with the residual torso on 4 seeds and with two critics on 2: the two-critic
-    comparison must read the entry's seeds 0 and 1 only (it once read all four, and a probe that is the shipped
-    entry was compared with itself on another probe's seeds)."""
+def test_the_results_page_task_table_by_hand():
+    """One row per task, the agents in the page's order, mean [bootstrap interval], seeds and mean SM of the final
+    evaluations: decqn-9's runs 0 and 10 (and SM 0.01, 0.03) read 5 [0, 10] (2 seeds), SM 0.0200."""
     import pandas as pd
 
-    from sb3_gqn.experiments.report import comparisons_per_task
-
-    tables = readme_tables()
-    finger = "dm_control/finger-spin-v0"
-    entry = tables.SHIPPED[finger]
-
-    def runs(algo: str, returns: list[float]) -> list[dict]:
-        return [
-            {"algo": algo, "env": finger, "penalty": 0.1, "seed": seed, "step": 100_000, "return": value, "smoothness": 0.01}
-            for seed, value in enumerate(returns)
-        ]
-
-    table = pd.DataFrame(
-        runs("gqn-adaptive" + entry, [100, 200, 900, 900])
-        + runs("gqn-adaptive+residual+1update", [300, 300, 300, 300])
-        + runs("gqn-adaptive+twin", [250, 250])
-        + runs("decqn-9" + entry, [400, 100, 500, 500])
-        + runs("decqn-9+twin", [300, 100])
-    )
-    residual, twin = tables.item_5_kinds(table)
-    assert twin[1] == [
-        ("gqn-adaptive, two critics", "gqn-adaptive, shipped entry"),
-        ("decqn-9, two critics", "decqn-9, shipped entry"),
-        ("gqn-adaptive, two critics", "decqn-9, two critics"),
-        ("gqn-adaptive, shipped entry", "decqn-9, shipped entry"),
-    ]
-    assert residual[1] == [
-        ("gqn-adaptive, residual torso", "gqn-adaptive, shipped entry"),
-        ("gqn-adaptive, residual torso", "decqn-9, residual torso"),
-        ("gqn-adaptive, residual torso", "sac"),
-    ]
-    twin_entry = pd.concat(twin[0]).query("algo == 'gqn-adaptive, shipped entry'")
-    assert sorted(twin_entry["seed"]) == [0, 1]
-    body = comparisons_per_task(pd.concat(twin[0]), twin[1], reps=200).body
-    rows = {row.split(" | ")[1]: row for row in body.splitlines()[2:]}
-    # two critics 250 against the entry's (100 + 200) / 2 = 150 on seeds 0-1 (on all four it would read 525)
-    assert "| 2 / 2 | +100 [" in rows["gqn-adaptive, two critics vs gqn-adaptive, shipped entry"]
-    # decqn-9's two critics (300 + 100) / 2 = 200 against its entry's (400 + 100) / 2 = 250 on the same seeds
-    assert "| 2 / 2 | -50 [" in rows["decqn-9, two critics vs decqn-9, shipped entry"]
-    assert "| 2 / 2 | +50 [" in rows["gqn-adaptive, two critics vs decqn-9, two critics"]  # 250 against 200
-    # the shipped pair on the two-critic seeds only: 150 against 250 (on all four seeds 525 against 375)
-    assert "| 2 / 2 | -100 [" in rows["gqn-adaptive, shipped entry vs decqn-9, shipped entry"]
-    body = comparisons_per_task(pd.concat(residual[0]), residual[1], reps=200).body
-    assert "| 4 / 4 | -225 [" in body  # 300 against (100 + 200 + 900 + 900) / 4 = 525
-    merged = tables.merged_rows(["| env | x |\n| --- | --- |\n| b | 1 |\n| a | 2 |", "| env | x |\n| --- | --- |\n| a | 3 |"])
-    assert merged.splitlines() == ["| env | x |", "| --- | --- |", "| a | 2 |", "| a | 3 |", "| b | 1 |"]
+    rows = [
+        {"algo": algo, "env": "dm_control/cartpole-swingup-v0", "penalty": 0.1, "seed": seed, "step": step, "return": value,
+         "smoothness": sm}
+        for algo, seed, value, sm in [("gqn-adaptive", 0, 7.0, 0.02), ("decqn-9", 0, 0.0, 0.01), ("decqn-9", 1, 10.0, 0.03)]
+        for step, value in [(50_000, -100.0), (100_000, value)]
+    ]  # fmt: skip
+    body = results_page().task_table(pd.DataFrame(rows)).splitlines()
+    assert body[0] == "| task | gqn-adaptive | decqn-9 |"
+    assert body[2] == "| cartpole-swingup | 7 (1 seed), SM 0.0200 | 5 [0, 10] (2 seeds), SM 0.0200 |"
 
 
 @pytest.mark.parametrize(

@@ -1,8 +1,5 @@
-"""The README's and the results report's relative links point at files and headings that exist.
-
-The issue-11 results moved from the README into ``docs/results/README.md``; a link written from the wrong folder,
-or to a heading renamed since, would render as a dead link on GitHub without any other check noticing.
-"""
+"""The Markdown documents' relative links point at files and headings that exist: a link written from the wrong
+folder, or to a heading renamed since, would render as a dead link on GitHub without any other check noticing."""
 
 from __future__ import annotations
 
@@ -16,7 +13,6 @@ DOCUMENTS = [
     "README.md",
     "CHANGELOG.md",
     "docs/results/README.md",
-    "docs/results/decision_rules.md",
     "docs/research/README.md",
 ]
 LINK = re.compile(r"\]\(([^)\s]+)\)")

@@ -24,7 +24,7 @@ BUDGETS = {"learn(20_000)": "learn(1_200)"}
 NOT_RUN_HERE = {
     "make results": "the main job (~10 min): its two commands run in test_reference_run.py and test_benchmark.py",
     "make test": "the test suite itself, which runs this test (CI)",
-    "make readme-tables": "rewrites committed files; its functions are tested in test_benchmark.py",
+    "make results-page": "rewrites committed files; its functions are tested in test_benchmark.py",
 }
 
 

@@ -184,3 +184,14 @@ def test_compare_option_rejects_bad_pairs_and_unknown_algorithms(tmp_path, capsy
     assert "no runs of sac" in capsys.readouterr().err
     assert main([str(table), "--compare", "a:b", "--reps", "100"]) == 0
     assert "Comparisons per task" in capsys.readouterr().out
+
+
+def test_mean_interval_by_hand():
+    from sb3_gqn.experiments.significance import mean_interval
+
+    assert mean_interval(np.array([5.0, 5.0, 5.0])) == (5.0, (5.0, 5.0))  # nothing varies: the value itself
+    mean, (low, high) = mean_interval(np.array([3.0]))
+    assert mean == 3.0 and np.isnan(low) and np.isnan(high)  # one run: no interval
+    # two runs 0 and 10: a replicate's mean is 0, 5 or 10 with probabilities 1/4, 1/2, 1/4, so the 2.5 % and
+    # 97.5 % percentiles of 2 000 replicates are the extremes
+    assert mean_interval(np.array([0.0, 10.0])) == (5.0, (0.0, 10.0))

@@ -36,6 +36,24 @@ RADAR_CAPTION = (
 RADAR_CLIP = 4.0
 RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 RADAR_DASHES = ("-", "--", "-.", ":")
+#: One colour per agent in every figure; agents not listed take the remaining colours in order of appearance
+AGENT_COLORS = {
+    "gqn-adaptive": "tab:green",
+    "gqn-linear": "tab:olive",
+    "decqn-9": "tab:blue",
+    "decqn-2": "tab:red",
+    "sac": "tab:purple",
+    "td3": "tab:brown",
+}
+_OTHER_COLORS = ("tab:orange", "tab:cyan", "tab:pink", "tab:gray", "gold", "navy", "teal", "maroon")
+
+
+def agent_colors(agents: list[str]) -> dict[str, str]:
+    """The colour of each agent: :data:`AGENT_COLORS`' where it has one, else the next unused of the others."""
+    others = iter(color for color in _OTHER_COLORS if color not in AGENT_COLORS.values())
+    return {agent: AGENT_COLORS.get(agent) or next(others, "black") for agent in agents}
+
+
 # Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
 PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
 PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
@@ -121,21 +139,28 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 fontsize=9,
                 bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
             )
+        colors = agent_colors(sorted(task["algo"].unique()))
+        most_seeds = 0
         for algo, runs in task.groupby("algo"):
             curve = mean_curve(runs)
             half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
+            seeds = int(curve["count"].max())
+            most_seeds = max(most_seeds, seeds)
             for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
-                seeds = int(curve["count"].max())
-                (line,) = axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})")
-                axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2)
-            _mark_growth_events(axes[0], runs, curve, line.get_color())
+                label = f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})"
+                axis.plot(x, curve["mean"], label=label, color=colors[str(algo)])
+                axis.fill_between(
+                    x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2, color=colors[str(algo)]
+                )
+            _mark_growth_events(axes[0], runs, curve, colors[str(algo)])
         if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
-            axes[0].plot([], [], "v", color="grey", label="growth (new bin count)")
+            axes[0].errorbar([], [], xerr=[], fmt="v", color="grey", label="growth to n bins: median step, range over seeds")
         axes[0].set_xlabel("environment steps")
         axes[1].set_xlabel("training wall time [s], median over seeds")
         axes[0].set_ylabel("greedy return (penalized)")
         axes[0].legend(fontsize=8)
-        figure.suptitle(f"{env}, action penalty c = {penalty:g} (mean, 95 % CI over seeds)")
+        spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
+        figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
         figure.tight_layout()
         path = out / f"learning_curves_{_slug(env)}_c{penalty:g}.png"
         figure.savefig(path, dpi=110)
@@ -155,13 +180,26 @@ def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list
     return [(int(step), int(bins)) for step, bins in (event.split(":") for event in text.split())]
 
 
-def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
-    """A triangle on the algorithm's mean curve at every growth of each of its seeds, labelled with the new bins."""
+def growth_steps(runs: pd.DataFrame) -> dict[int, list[int]]:
+    """The env steps at which an agent's seeds grew to each bin count: ``{bins: [step of each seed that got there]}``."""
+    steps: dict[int, list[int]] = {}
     for _, run in runs.groupby("seed"):
         for step, bins in run_growth_events(run):
-            value = float(np.interp(step, curve.index.to_numpy(), curve["mean"].to_numpy()))
-            axis.plot([step], [value], "v", color=color, markersize=6, markeredgecolor="black", markeredgewidth=0.5)
-            axis.annotate(str(bins), (step, value), textcoords="offset points", xytext=(0, 6), fontsize=6, ha="center")
+            steps.setdefault(bins, []).append(step)
+    return steps
+
+
+def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
+    """One triangle per level the agent grew to, on its mean curve at the median step over its seeds, with a bar over
+    the seeds' range of steps and the new bin count above it (one label per level, however many seeds)."""
+    for bins, steps in sorted(growth_steps(runs).items()):
+        median, low, high = float(np.median(steps)), min(steps), max(steps)
+        value = float(np.interp(median, curve.index.to_numpy(), curve["mean"].to_numpy()))
+        axis.errorbar(
+            [median], [value], xerr=[[median - low], [high - median]], fmt="v", color=color, markersize=6,
+            markeredgecolor="black", markeredgewidth=0.5, elinewidth=1, capsize=2,
+        )  # fmt: skip
+        axis.annotate(str(bins), (median, value), textcoords="offset points", xytext=(0, 7), fontsize=7, ha="center")
 
 
 def final_rows(table: pd.DataFrame) -> pd.DataFrame:
@@ -234,9 +272,10 @@ def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | 
     estimates, intervals = iqm_with_intervals(scores, reps)
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
     figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
+    colors = agent_colors(sorted(algos))
     for row, algo in enumerate(algos):
         low, high = intervals[algo][:, 0]
-        axis.barh(row, high - low, left=low, height=0.6, alpha=0.6)
+        axis.barh(row, high - low, left=low, height=0.6, alpha=0.6, color=colors[algo])
         axis.plot([estimates[algo][0]] * 2, [row - 0.3, row + 0.3], color="black")
         runs = int(scores[algo].shape[0])
         if runs == 1:  # one run per task: no interval to draw, say so instead of showing an empty row
@@ -307,6 +346,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         base = means.loc[reference].replace(0.0, np.nan)
         angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
         figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
+        colors = agent_colors(sorted({str(algo) for algo, _ in means.index}))
         any_clipped = False
         for index, ((algo, penalty), values) in enumerate(means.iterrows()):
             relative = (values / base).abs()
@@ -319,6 +359,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
                 np.append(angles, angles[0]),
                 closed,
                 label=f"{algo} c={penalty:g}",
+                color=colors[str(algo)],
                 marker=RADAR_MARKERS[index % len(RADAR_MARKERS)],
                 linestyle=RADAR_DASHES[index % len(RADAR_DASHES)],
                 markersize=6,

@@ -8,7 +8,7 @@
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
-* the final greedy evaluation of every run (return, task return, P, ``|Δa|``, SM, bins, training seconds);
+* the final greedy evaluation of every run (return, task return, P, mean action change, SM, bins, training seconds);
 * per algorithm and task, the mean final return and SM over seeds;
 * the growth check of every GQN run: for each growth event, the last evaluation of the policy before it and
   the first after it that the growth can have changed (growth_checks), and whether the return held

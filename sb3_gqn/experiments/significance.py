@@ -96,6 +96,18 @@ def difference_interval(
     return float(estimates["pair"][0]), (float(intervals["pair"][0, 0]), float(intervals["pair"][1, 0]))
 
 
+def mean_interval(values: np.ndarray, reps: int = 2000, seed: int = 0) -> tuple[float, tuple[float, float]]:
+    """The mean of one agent's runs on one task and its 95 % percentile bootstrap interval (runs resampled with
+    replacement); ``seed`` fixes the draws. One run gives no interval (NaN bounds); equal runs give the value itself."""
+    values = np.ravel(np.asarray(values, dtype=np.float64))
+    if len(values) < 2:
+        return float(values.mean()), (math.nan, math.nan)
+    rng = np.random.default_rng(seed)
+    replicates = rng.choice(values, size=(reps, len(values))).mean(axis=1)
+    low, high = np.percentile(replicates, [2.5, 97.5])
+    return float(values.mean()), (float(low), float(high))
+
+
 def pooled_iqm(per_task: list[np.ndarray]) -> float:
     """IQM of every run of every task pooled, for tasks with unequal run counts: the mean of the middle half of all
     scores (``scipy.stats.trim_mean(..., 0.25)``, rliable's ``aggregate_iqm`` on the flattened scores).

@@ -1,0 +1,138 @@
+"""Rebuild the results page and the README's results table from the committed tables (``make results-page``).
+
+Reads the comparison suite's ``docs/results/<task>_c0.1_100k*/results.csv`` files, maps the runs of each task's shipped
+entry to the plain agent names (:func:`shipped`), and rewrites the blocks between ``<!-- BEGIN generated: NAME -->`` and
+``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``), and the
+figures in ``docs/results/main/``. The prose around the blocks is written by hand. Run from the repository root after
+extending a table with the comparison runner.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from sb3_gqn.experiments.plots import aggregate, final_rows, learning_curves, smoothness_radar
+from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
+from sb3_gqn.experiments.significance import mean_interval
+from sb3_gqn.experiments.variants import load_variants
+
+RESULTS = Path("docs/results")
+PAGE = RESULTS / "README.md"
+README = Path("README.md")
+#: The tables hold the research record's agents too (their names are in the variants file)
+RESEARCH_VARIANTS = Path("docs/research/variants.yml")
+#: The entries (gqn.yml, decqn.yml) a task has shipped, oldest first, each as the runner's variant suffix that trains
+#: exactly it ("" = the plain names); the last is the shipped one. Tasks not listed have shipped one entry.
+ENTRIES = {
+    "dm_control/walker-walk-v0": ["", "+layernorm+1update", "+residual+1update"],
+    "dm_control/finger-spin-v0": ["", "+layernorm+1update"],
+}
+SHIPPED = {env: entries[-1] for env, entries in ENTRIES.items()}
+MAIN_ALGOS = ["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"]
+BASELINES = ["sac"]
+#: how far gqn-adaptive and gqn-linear are ahead of the static baselines, across tasks and per task; SAC per task
+MAIN_PAIRS = [
+    ("gqn-adaptive", "decqn-9"),
+    ("gqn-adaptive", "decqn-2"),
+    ("gqn-linear", "decqn-9"),
+    ("gqn-adaptive", "gqn-linear"),
+]
+BASELINE_PAIRS = [("gqn-adaptive", "sac"), ("gqn-linear", "sac"), ("decqn-9", "sac")]
+MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
+#: the IQM reads 8 runs per agent and task, each agent's lowest seeds (0-7); the "every run" columns pool them all
+IQM_RUNS = 8
+
+
+def shipped(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs.
+
+    Every agent of the main comparison must have run the shipped variant on every seed it ran with an earlier entry:
+    a missing one would otherwise leave the first entry's runs under the plain name, mixed with the shipped ones, or
+    shrink the tables' seeds without a word.
+    """
+    for env, entries in ENTRIES.items():
+        seeds = table[table["env"] == env].groupby("algo")["seed"].agg(set)
+        for agent in MAIN_ALGOS:
+            earlier = set().union(*(seeds.get(agent + suffix, set()) for suffix in entries[:-1]))
+            missing = earlier - seeds.get(agent + entries[-1], set())
+            if missing:
+                raise SystemExit(
+                    f"{env}: {agent + entries[-1]} (the shipped entry) lacks seeds {sorted(missing)} that {agent} ran "
+                    "with an earlier entry; run them before rebuilding the tables"
+                )
+        table = as_shipped(table, env, entries[-1])
+    return table
+
+
+def comparison_table() -> pd.DataFrame:
+    """The main comparison's runs: the shipped entries of the four GQN/DecQN agents and SAC, under the plain names."""
+    table = shipped(load([RESULTS / name / "results.csv" for name in MAIN_TABLES]))
+    return table[table["algo"].isin([*MAIN_ALGOS, *BASELINES])]
+
+
+def task_table(table: pd.DataFrame) -> str:
+    """One row per task, one column per agent: mean final return [95 % bootstrap interval] and mean SM over seeds."""
+    final = final_rows(table)
+    agents = [agent for agent in [*MAIN_ALGOS, *BASELINES] if agent in set(final["algo"])]
+    lines = ["| task | " + " | ".join(agents) + " |", "| --- |" + " --- |" * len(agents)]
+    for env, runs in final.groupby("env"):
+        cells = []
+        for agent in agents:
+            agent_runs = runs[runs["algo"] == agent]
+            mean, (low, high) = mean_interval(agent_runs["return"].to_numpy())
+            spread = f"[{low:.0f}, {high:.0f}] ({len(agent_runs)} seeds)" if len(agent_runs) > 1 else "(1 seed)"
+            cells.append(f"{mean:.0f} {spread}, SM {agent_runs['smoothness'].mean():.4f}")
+        lines.append(f"| {str(env).split('/')[-1].removesuffix('-v0')} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main_block(table: pd.DataFrame) -> str:
+    """The results page's tables, and the figures drawn into ``docs/results/main``."""
+    main = table[table["algo"].isin(MAIN_ALGOS)]
+    # Curves and radars show SAC where it ran; the IQM figure normalizes over the same runs as the IQM table
+    learning_curves(table, RESULTS / "main")
+    smoothness_radar(table, RESULTS / "main")
+    aggregate(main, RESULTS / "main", max_runs=IQM_RUNS)
+    iqm = report_sections(main, reps=2000, max_runs=IQM_RUNS)["iqm"]
+    across = comparisons_across_tasks(main, MAIN_PAIRS, reps=2000, max_runs=IQM_RUNS)
+    per_task = comparisons_per_task(table, [*MAIN_PAIRS, *BASELINE_PAIRS], reps=2000)
+    assert across is not None and per_task is not None, "the main tables hold every pair on every task"
+    return "\n\n".join(
+        [
+            "**Final greedy return per task: mean over seeds [95 % bootstrap interval] (seeds), mean SM**",
+            task_table(table),
+            f"**{iqm.heading}**",
+            iqm.body,
+            f"**{across.heading}**",
+            across.body,
+            f"**{per_task.heading}**",
+            per_task.body,
+        ]
+    )
+
+
+def replace_block(path: Path, name: str, body: str) -> None:
+    """Rewrite the generated block ``name`` of the Markdown file ``path``."""
+    text = path.read_text()
+    begin, end = f"<!-- BEGIN generated: {name} -->", f"<!-- END generated: {name} -->"
+    if begin not in text or end not in text:
+        raise SystemExit(f"{path}: no block {begin} ... {end}")
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    path.write_text(f"{head}{begin}\n{body}\n{end}{tail}")
+
+
+def run() -> int:
+    load_variants(RESEARCH_VARIANTS)
+    table = comparison_table()
+    replace_block(PAGE, "main", main_block(table))
+    replace_block(README, "results", task_table(table))
+    print(f"rebuilt {PAGE} (main), {README} (results) and the figures in {RESULTS / 'main'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(run())
