@@ -81,3 +81,45 @@ def check_replay_sizes(buffer_size: int, batch_size: int, n_steps: int) -> None:
         )
     if buffer_size <= n_steps:
         raise ValueError(f"buffer_size={buffer_size} must exceed n_steps={n_steps} to hold an n-step return")
+
+
+#: argument -> smallest valid integer, for the integer arguments of GQN's constructor
+_INTEGER_ARGUMENTS = {
+    "buffer_size": 1,
+    "learning_starts": 0,
+    "batch_size": 1,
+    "n_steps": 1,
+    "target_update_interval": 1,
+    "stats_window_size": 1,
+}
+#: argument -> (low, high, low_open) of the valid interval, for the numeric arguments of GQN's constructor
+_NUMBER_ARGUMENTS = {
+    "tau": (0.0, 1.0, True),
+    "gamma": (0.0, 1.0, True),
+    "exploration_fraction": (0.0, 1.0, False),
+    "exploration_initial_eps": (0.0, 1.0, False),
+    "exploration_final_eps": (0.0, 1.0, False),
+    "priority_exponent": (0.0, math.inf, False),
+    "importance_sampling_exponent": (0.0, 1.0, False),
+}
+#: optional numeric arguments (``None`` switches them off): (low, high, low_open)
+_OPTIONAL_NUMBER_ARGUMENTS = {"acting_tau": (0.0, 1.0, True), "max_grad_norm": (0.0, math.inf, True)}
+
+
+def check_learning_arguments(**arguments: Any) -> dict[str, Any]:
+    """GQN's learning arguments (learning rate, replay, update, exploration and priority settings), each checked as
+    above; returns them normalized (ints as ``int``, numbers as ``float``). ``gradient_steps`` may be 0 (SB3's
+    "collect only") or -1 (as many as env steps)."""
+    checked = dict(arguments)
+    checked["learning_rate"] = check_learning_rate(arguments["learning_rate"])
+    for name, minimum in _INTEGER_ARGUMENTS.items():
+        checked[name] = check_int(name, arguments[name], minimum)
+    for name, (low, high, low_open) in _NUMBER_ARGUMENTS.items():
+        checked[name] = check_number(name, arguments[name], low, high, low_open=low_open)
+    for name, (low, high, low_open) in _OPTIONAL_NUMBER_ARGUMENTS.items():
+        if arguments[name] is not None:
+            checked[name] = check_number(name, arguments[name], low, high, low_open=low_open)
+    checked["gradient_steps"] = check_int("gradient_steps", arguments["gradient_steps"], 0, special=(-1,))
+    check_train_freq(arguments["train_freq"])
+    check_replay_sizes(checked["buffer_size"], checked["batch_size"], checked["n_steps"])
+    return checked

@@ -17,14 +17,7 @@ from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedul
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.common.arguments import (
-    check_choice,
-    check_int,
-    check_learning_rate,
-    check_number,
-    check_replay_sizes,
-    check_train_freq,
-)
+from sb3_gqn.common.arguments import check_choice, check_learning_arguments
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.masking import EXPLORATION_MODES, active_bin_indices, epsilon_greedy
@@ -35,7 +28,6 @@ from sb3_gqn.gqn.growth.resolution import GrowingResolution
 from sb3_gqn.gqn.growth.schedules import (
     GROWTH_INITS,
     GROWTH_SCHEDULES,
-    RETURN_SOURCES,
     AdaptiveGrowth,
     bin_levels_from,
 )
@@ -182,37 +174,25 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         device: th.device | str = "auto",
         _init_setup_model: bool = True,
     ):
-        # Every argument is checked here, when the model is built (sb3_gqn.common.arguments)
-        learning_rate = check_learning_rate(learning_rate)
-        buffer_size = check_int("buffer_size", buffer_size, 1)
-        learning_starts = check_int("learning_starts", learning_starts, 0)
-        batch_size = check_int("batch_size", batch_size, 1)
-        tau = check_number("tau", tau, 0.0, 1.0, low_open=True)
-        gamma = check_number("gamma", gamma, 0.0, 1.0, low_open=True)
-        check_train_freq(train_freq)
-        gradient_steps = check_int("gradient_steps", gradient_steps, 0, special=(-1,))  # 0: collect only (SB3)
-        n_steps = check_int("n_steps", n_steps, 1)
-        check_replay_sizes(buffer_size, batch_size, n_steps)
-        target_update_interval = check_int("target_update_interval", target_update_interval, 1)
-        if acting_tau is not None:
-            acting_tau = check_number("acting_tau", acting_tau, 0.0, 1.0, low_open=True)
-        check_number("exploration_fraction", exploration_fraction, 0.0, 1.0)
-        check_number("exploration_initial_eps", exploration_initial_eps, 0.0, 1.0)
-        check_number("exploration_final_eps", exploration_final_eps, 0.0, 1.0)
-        if max_grad_norm is not None:
-            check_number("max_grad_norm", max_grad_norm, 0.0, low_open=True)
-        check_number("priority_exponent", priority_exponent, 0.0)
-        check_number("importance_sampling_exponent", importance_sampling_exponent, 0.0, 1.0)
-        check_int("growth_eval_freq", growth_eval_freq, 1)
-        check_int("growth_eval_episodes", growth_eval_episodes, 1)
-        check_int("growth_window", growth_window, 1)
-        if growth_patience is not None:
-            check_int("growth_patience", growth_patience, 1)
-        check_number("growth_min_improvement", growth_min_improvement, 0.0)
-        if growth_probation is not None:
-            check_int("growth_probation", growth_probation, 1)
-        check_int("stats_window_size", stats_window_size, 1)
-        check_choice("growth_returns", growth_returns, RETURN_SOURCES)
+        # Every argument is checked here, when the model is built (sb3_gqn.common.arguments); the growth schedule's
+        # own arguments by AdaptiveGrowth, whichever schedule runs
+        learning = check_learning_arguments(
+            learning_rate=learning_rate, buffer_size=buffer_size, learning_starts=learning_starts, batch_size=batch_size,
+            tau=tau, gamma=gamma, train_freq=train_freq, gradient_steps=gradient_steps, n_steps=n_steps,
+            target_update_interval=target_update_interval, acting_tau=acting_tau, exploration_fraction=exploration_fraction,
+            exploration_initial_eps=exploration_initial_eps, exploration_final_eps=exploration_final_eps,
+            max_grad_norm=max_grad_norm, priority_exponent=priority_exponent,
+            importance_sampling_exponent=importance_sampling_exponent, stats_window_size=stats_window_size,
+        )  # fmt: skip
+        adaptive_schedule = AdaptiveGrowth(
+            eval_freq=growth_eval_freq,
+            eval_episodes=growth_eval_episodes,
+            window=growth_window,
+            returns_source=growth_returns,
+            patience=growth_patience,
+            min_improvement=growth_min_improvement,
+            probation=growth_probation,
+        )
         check_choice("growth", growth, GROWTH_SCHEDULES)
         check_choice("growth_init", growth_init, GROWTH_INITS)
         check_choice("exploration", exploration, EXPLORATION_MODES)
@@ -224,19 +204,19 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         super().__init__(
             policy,
             env,
-            learning_rate,
-            buffer_size,
-            learning_starts,
-            batch_size,
-            tau,
-            gamma,
+            learning["learning_rate"],
+            learning["buffer_size"],
+            learning["learning_starts"],
+            learning["batch_size"],
+            learning["tau"],
+            learning["gamma"],
             train_freq,
-            gradient_steps,
+            learning["gradient_steps"],
             action_noise=None,  # exploration is epsilon-greedy over the active bins
             replay_buffer_class=replay_buffer_class,
             replay_buffer_kwargs=replay_buffer_kwargs,
             optimize_memory_usage=optimize_memory_usage,
-            n_steps=n_steps,
+            n_steps=learning["n_steps"],
             policy_kwargs=policy_kwargs,
             stats_window_size=stats_window_size,
             tensorboard_log=tensorboard_log,
@@ -247,8 +227,8 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
             supported_action_spaces=(spaces.Box, spaces.Discrete, spaces.MultiDiscrete),
             support_multi_env=True,
         )
-        self.target_update_interval = target_update_interval
-        self.acting_tau = acting_tau
+        self.target_update_interval = learning["target_update_interval"]
+        self.acting_tau = learning["acting_tau"]
         self.exploration_initial_eps = exploration_initial_eps
         self.exploration_final_eps = exploration_final_eps
         self.exploration_fraction = exploration_fraction
@@ -270,17 +250,7 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         self.deployments: list[tuple[int, int]] = []
         # The level predict() acts on while an opened level is on probation; None: the growth level
         self._deployed_level: int | None = None
-        self.growth_schedule: AdaptiveGrowth | None = None
-        if growth == "adaptive":
-            self.growth_schedule = AdaptiveGrowth(
-                eval_freq=growth_eval_freq,
-                eval_episodes=growth_eval_episodes,
-                window=growth_window,
-                returns_source=growth_returns,
-                patience=growth_patience,
-                min_improvement=growth_min_improvement,
-                probation=growth_probation,
-            )
+        self.growth_schedule: AdaptiveGrowth | None = adaptive_schedule if growth == "adaptive" else None
         if _init_setup_model:
             self._setup_model()
 
