@@ -344,3 +344,25 @@ def test_two_critics_keep_the_entry_torso():
     assert added_policy_kwargs("dict()", "n_critics=2") == "dict(n_critics=2)"
     with pytest.raises(ValueError, match="expected 'dict"):
         added_policy_kwargs("{'a': 1}", "n_critics=2")
+
+
+def test_the_main_job_sentence_reads_the_committed_reference_runs(tmp_path):
+    """Ranges over the seeds' final_evaluation.json: returns 700 and 812.4, level 9 reached by one of two seeds."""
+    for seed, value, events, speed in [
+        (0, 700.0, [(9_000, 3), (20_500, 5), (40_000, 9)], 150.0),
+        (1, 812.4, [(12_000, 3), (30_000, 5)], 171.6),
+    ]:
+        run = tmp_path / f"run{seed}"
+        run.mkdir()
+        summary = {
+            "args": {"seed": seed},
+            "final_evaluation": {"return_mean": value},
+            "env_steps_per_second": speed,
+            "growth_events": [{"step": step, "active_bins": bins} for step, bins in events],
+        }
+        (run / "final_evaluation.json").write_text(json.dumps(summary))
+    sentence = results_page().main_job_block(tmp_path)
+    assert "Over seeds 0, 1 of the committed runs" in sentence
+    assert "the final greedy return is 700-812 (10 episodes each)" in sentence
+    assert "the levels open to 3 at 9k-12k steps, to 5 at 20k-30k steps, to 9 at 40k-40k steps (1 of 2 seeds)" in sentence
+    assert "training runs at 150-172 env steps/s" in sentence

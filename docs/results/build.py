@@ -2,13 +2,15 @@
 
 Reads the comparison suite's ``docs/results/<task>_c0.1_100k*/results.csv`` files, maps the runs of each task's shipped
 entry to the plain agent names (:func:`shipped`), and rewrites the blocks between ``<!-- BEGIN generated: NAME -->`` and
-``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``), and the
+``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``, and
+``main-job`` from the committed reference runs in ``docs/results/reference_run/``), and the
 figures in ``docs/results/main/``. The prose around the blocks is written by hand. Run from the repository root after
 extending a table with the comparison runner.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -114,6 +116,32 @@ def main_block(table: pd.DataFrame) -> str:
     )
 
 
+def main_job_block(runs: Path = RESULTS / "reference_run") -> str:
+    """What the main job (``make results``' reference run) gives over its committed seeds: the final greedy return (10
+    episodes each), the steps at which each level opened, and the env steps/s, as ranges over the seeds."""
+    summaries = [json.loads(path.read_text()) for path in sorted(runs.glob("*/final_evaluation.json"))]
+    if not summaries:
+        raise SystemExit(f"no committed reference runs in {runs}")
+    seeds = sorted(int(summary["args"]["seed"]) for summary in summaries)
+    returns = [summary["final_evaluation"]["return_mean"] for summary in summaries]
+    speeds = [summary["env_steps_per_second"] for summary in summaries]
+    opened: dict[int, list[int]] = {}
+    for summary in summaries:
+        for event in summary["growth_events"]:
+            opened.setdefault(int(event["active_bins"]), []).append(int(event["step"]))
+    levels = ", ".join(
+        f"to {bins} at {min(steps) / 1000:.0f}k-{max(steps) / 1000:.0f}k steps"
+        + (f" ({len(steps)} of {len(summaries)} seeds)" if len(steps) < len(summaries) else "")
+        for bins, steps in sorted(opened.items())
+    )
+    return (
+        f"Over seeds {', '.join(map(str, seeds))} of the committed runs (`docs/results/reference_run/`), the final greedy "
+        f"return is {min(returns):.0f}-{max(returns):.0f} (10 episodes each); the levels open {levels}; training runs at "
+        f"{min(speeds):.0f}-{max(speeds):.0f} env steps/s (this 2-core machine, two runs sharing it, one torch thread "
+        "each)."
+    )
+
+
 def replace_block(path: Path, name: str, body: str) -> None:
     """Rewrite the generated block ``name`` of the Markdown file ``path``."""
     text = path.read_text()
@@ -130,7 +158,8 @@ def run() -> int:
     table = comparison_table()
     replace_block(PAGE, "main", main_block(table))
     replace_block(README, "results", task_table(table))
-    print(f"rebuilt {PAGE} (main), {README} (results) and the figures in {RESULTS / 'main'}")
+    replace_block(README, "main-job", main_job_block())
+    print(f"rebuilt {PAGE} (main), {README} (results, main-job) and the figures in {RESULTS / 'main'}")
     return 0
 
 
