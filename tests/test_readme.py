@@ -81,3 +81,32 @@ def test_the_commands_run(tmp_path):
         result = run(command, tmp_path, shell=True)
         assert result.returncode == 0, f"{command}\n{result.stderr[-3000:]}"
     assert (tmp_path / "results" / "short" / "results.csv").is_file()
+
+
+def test_the_how_it_works_table_names_functions_that_exist():
+    """Every name in the README's "How it works" table resolves (short names relative to ``sb3_gqn``, a bare name to the
+    module named before it in the same cell)."""
+    import importlib
+
+    section = README.split("## How it works", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| ") and "`" in line.split("|")[-2]]
+    assert len(rows) >= 6
+    for row in rows:
+        module = None
+        for name in re.findall(r"`([\w.]+)`", row.split("|")[-2]):
+            if "." in name:
+                path = name if name.startswith("sb3_gqn.") else f"sb3_gqn.{name}"
+                parts = path.split(".")
+                for cut in range(len(parts) - 1, 0, -1):  # the longest importable prefix is the module
+                    try:
+                        module = importlib.import_module(".".join(parts[:cut]))
+                    except ModuleNotFoundError:
+                        continue
+                    attributes = parts[cut:]
+                    break
+            else:
+                attributes = [name]
+            obj = module
+            for attribute in attributes:
+                obj = getattr(obj, attribute)
+            assert obj is not None, name
