@@ -140,19 +140,19 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
             )
         colors = agent_colors(sorted(task["algo"].unique()))
+        # every second agent that grows writes its bin counts below its marks, so two agents' labels stay apart
+        growing = [algo for algo, runs in task.groupby("algo") if growth_steps(runs)]
         most_seeds = 0
         for algo, runs in task.groupby("algo"):
             curve = mean_curve(runs)
             half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
             seeds = int(curve["count"].max())
             most_seeds = max(most_seeds, seeds)
+            color = colors[str(algo)]
             for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
-                label = f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})"
-                axis.plot(x, curve["mean"], label=label, color=colors[str(algo)])
-                axis.fill_between(
-                    x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2, color=colors[str(algo)]
-                )
-            _mark_growth_events(axes[0], runs, curve, colors[str(algo)])
+                axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})", color=color)
+                axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2, color=color)
+            _mark_growth_events(axes[0], runs, curve, color, below=algo in growing[1::2])
         if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
             axes[0].errorbar([], [], xerr=[], fmt="v", color="grey", label="growth to n bins: median step, range over seeds")
         axes[0].set_xlabel("environment steps")
@@ -189,9 +189,10 @@ def growth_steps(runs: pd.DataFrame) -> dict[int, list[int]]:
     return steps
 
 
-def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str) -> None:
+def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, color: str, below: bool = False) -> None:
     """One triangle per level the agent grew to, on its mean curve at the median step over its seeds, with a bar over
-    the seeds' range of steps and the new bin count above it (one label per level, however many seeds)."""
+    the seeds' range of steps and the new bin count above it, or below it with ``below`` (so that two agents' labels at
+    the same place stay apart); one label per level, however many seeds."""
     for bins, steps in sorted(growth_steps(runs).items()):
         median, low, high = float(np.median(steps)), min(steps), max(steps)
         value = float(np.interp(median, curve.index.to_numpy(), curve["mean"].to_numpy()))
@@ -199,7 +200,8 @@ def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, colo
             [median], [value], xerr=[[median - low], [high - median]], fmt="v", color=color, markersize=6,
             markeredgecolor="black", markeredgewidth=0.5, elinewidth=1, capsize=2,
         )  # fmt: skip
-        axis.annotate(str(bins), (median, value), textcoords="offset points", xytext=(0, 7), fontsize=7, ha="center")
+        offset = (0, -14) if below else (0, 7)
+        axis.annotate(str(bins), (median, value), textcoords="offset points", xytext=offset, fontsize=7, ha="center")
 
 
 def final_rows(table: pd.DataFrame) -> pd.DataFrame:
