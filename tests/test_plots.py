@@ -127,3 +127,19 @@ def test_mean_curve_averages_returns_and_places_each_step_at_the_median_wall_tim
     assert list(curve["mean"]) == [10.0, 60.0] and list(curve["count"]) == [3, 3]
     assert list(curve["std"]) == [10.0, 30.0]  # sample std of (0, 10, 20) and (30, 60, 90)
     assert list(curve["wall"]) == [110.0, 420.0]
+
+
+def test_one_colour_per_agent_and_growth_steps_by_hand():
+    from sb3_gqn.experiments.plots import AGENT_COLORS, agent_colors, growth_steps
+
+    colors = agent_colors(["sac", "gqn-adaptive", "my-agent", "other-agent"])
+    assert colors["gqn-adaptive"] == "tab:green" == AGENT_COLORS["gqn-adaptive"] and colors["sac"] == "tab:purple"
+    assert len(set(colors.values())) == 4 and not set(AGENT_COLORS.values()) & {colors["my-agent"], colors["other-agent"]}
+    runs = pd.DataFrame(
+        {
+            "seed": [0, 0, 1, 1],
+            "step": [10, 20, 10, 20],
+            "growth_events": ["5:3", "5:3 12:5", "7:3", "7:3 15:5 18:9"],  # the last row of a run holds all of its events
+        }
+    )
+    assert growth_steps(runs) == {3: [5, 7], 5: [12, 15], 9: [18]}
