@@ -8,18 +8,9 @@ import pytest
 
 import sb3_gqn.experiments.plots as plots
 from sb3_gqn import GQN
-from sb3_gqn.experiments.plots import (
-    RADAR_CLIP,
-    aggregate,
-    clipped_radii,
-    degenerate_tasks,
-    mean_curve,
-    normalized_final_scores,
-    q_value_picture,
-    return_radius,
-    save_q_snapshot,
-    smoothness_radar,
-)
+from sb3_gqn.experiments.plots import RADAR_CLIP, aggregate, clipped_radii, mean_curve, return_radius, smoothness_radar
+from sb3_gqn.experiments.q_values import q_value_picture, save_q_snapshot
+from sb3_gqn.experiments.scores import degenerate_tasks, normalized_final_scores
 
 
 def table(returns: dict[tuple[str, str], float]) -> pd.DataFrame:
@@ -96,7 +87,7 @@ def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
 def test_iqm_intervals_are_seeded_and_leave_the_global_numpy_stream_alone():
     """Regenerating the README's IQM table or figure gives the same intervals (rliable draws from NumPy's global
     generator); another seed gives other draws; the caller's stream continues where it was."""
-    from sb3_gqn.experiments.plots import iqm_with_intervals
+    from sb3_gqn.experiments.scores import iqm_with_intervals
 
     scores = {"a": np.random.default_rng(0).random((6, 3)), "b": np.random.default_rng(1).random((5, 3))}
     np.random.seed(7)

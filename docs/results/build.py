@@ -16,8 +16,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from sb3_gqn.experiments.plots import aggregate, final_rows, learning_curves, smoothness_radar
+from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
 from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
+from sb3_gqn.experiments.scores import final_rows
 from sb3_gqn.experiments.significance import mean_interval
 from sb3_gqn.experiments.variants import load_variants
 

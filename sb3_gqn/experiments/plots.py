@@ -1,4 +1,5 @@
-"""Figures of the comparison suite (paper figures 2-4) from ``results.csv`` and the runs' Q-value snapshots."""
+"""Figures of the comparison suite from ``results.csv``: learning curves (paper figure 3), the IQM across tasks and the
+smoothness radar (figure 4); the Q-value picture (figure 2) is :mod:`~sb3_gqn.experiments.q_values`'."""
 
 from __future__ import annotations
 
@@ -12,10 +13,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-import torch as th
-from stable_baselines3.common.callbacks import BaseCallback
 
-from sb3_gqn.experiments.significance import seeded_numpy_global_generator
+from sb3_gqn.experiments.q_values import q_value_picture
+from sb3_gqn.experiments.scores import (
+    degenerate_tasks,
+    final_rows,
+    iqm_with_intervals,
+    normalized_final_scores,
+    run_growth_events,
+)
 
 #: Figure 4's axes: column of results.csv -> label
 RADAR_METRICS = {
@@ -54,57 +60,8 @@ def agent_colors(agents: list[str]) -> dict[str, str]:
     return {agent: AGENT_COLORS.get(agent) or next(others, "black") for agent in agents}
 
 
-# Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
-PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
-PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
-
-
 def _slug(text: str) -> str:
     return text.replace("/", "-").replace(" ", "_")
-
-
-class QValueSnapshots(BaseCallback):
-    """Saves GQN's per-bin utilities over Pendulum's (angle, velocity) grid at the end of every growth level.
-
-    ``q_level<g>.npz`` holds ``utilities`` ``(angles, velocities, max_bins)``, the level's active bins and the grid.
-    """
-
-    def __init__(self, run_dir: Path):
-        super().__init__()
-        self.run_dir = Path(run_dir)
-        self.level = 0
-
-    def _snapshot(self, level: int) -> None:
-        angle, velocity = np.meshgrid(PENDULUM_ANGLES, PENDULUM_VELOCITIES, indexing="ij")
-        observations = np.stack([np.cos(angle), np.sin(angle), velocity], axis=-1).reshape(-1, 3).astype(np.float32)
-        with th.no_grad():
-            utilities = self.model.q_net(th.as_tensor(observations, device=self.model.device))  # type: ignore[attr-defined]
-        utilities = utilities[:, 0, :].cpu().numpy().reshape(len(PENDULUM_ANGLES), len(PENDULUM_VELOCITIES), -1)
-        grid = getattr(self.model, "action_grid", None)
-        np.savez(
-            self.run_dir / f"q_level{level}.npz",
-            utilities=utilities,
-            bin_values=grid.values[0] if grid is not None else np.arange(utilities.shape[-1], dtype=np.float32),
-            active_bins=self.model.bin_levels[level],  # type: ignore[attr-defined]
-            max_bins=self.model.bin_levels[-1],  # type: ignore[attr-defined]
-            angles=PENDULUM_ANGLES,
-            velocities=PENDULUM_VELOCITIES,
-            step=self.num_timesteps,
-        )
-
-    def _on_step(self) -> bool:
-        level = self.model.growth_level  # type: ignore[attr-defined]
-        if level != self.level:  # the network as it was trained at the previous level
-            self._snapshot(self.level)
-            self.level = level
-        return True
-
-    def _on_training_end(self) -> None:
-        self._snapshot(self.model.growth_level)  # type: ignore[attr-defined]
-
-
-def save_q_snapshot(run_dir: Path) -> QValueSnapshots:
-    return QValueSnapshots(run_dir)
 
 
 def mean_curve(runs: pd.DataFrame) -> pd.DataFrame:
@@ -169,17 +126,6 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
     return paths
 
 
-def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list[tuple[int, int]]:
-    """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row (``deployments``:
-    the changes of the level its evaluations acted on)."""
-    if column not in runs or runs.empty:
-        return []
-    text = runs.sort_values("step")[column].iloc[-1]
-    if not isinstance(text, str) or not text.strip():
-        return []
-    return [(int(step), int(bins)) for step, bins in (event.split(":") for event in text.split())]
-
-
 def growth_steps(runs: pd.DataFrame) -> dict[int, list[int]]:
     """The env steps at which an agent's seeds grew to each bin count: ``{bins: [step of each seed that got there]}``."""
     steps: dict[int, list[int]] = {}
@@ -202,69 +148,6 @@ def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, colo
         )  # fmt: skip
         offset = (0, -14) if below else (0, 7)
         axis.annotate(str(bins), (median, value), textcoords="offset points", xytext=offset, fontsize=7, ha="center")
-
-
-def final_rows(table: pd.DataFrame) -> pd.DataFrame:
-    """The last evaluation of every run."""
-    last = table.groupby(["algo", "env", "penalty", "seed"])["step"].transform("max")
-    return table[table["step"] == last]
-
-
-def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarray]], list[tuple[str, float]]]:
-    """Final returns min-max normalized per task (env, penalty) over all of that task's runs: ``{algo: [runs of
-    each task]}`` (every run, counts may differ between tasks) and the tasks."""
-    final = final_rows(table).copy()
-    task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
-    final = final.join(task_range, on=["env", "penalty"])
-    spread = (final["max"] - final["min"]).replace(0.0, 1.0)
-    final["normalized"] = (final["return"] - final["min"]) / spread
-    final = final.sort_values("seed", kind="stable")  # lowest seeds first, so a cut keeps the same seeds everywhere
-    tasks = sorted(set(zip(final["env"], final["penalty"])))
-    runs_by_algo = {
-        str(algo): [runs[(runs["env"] == env) & (runs["penalty"] == c)]["normalized"].to_numpy() for env, c in tasks]
-        for algo, runs in final.groupby("algo")
-    }
-    return runs_by_algo, tasks
-
-
-def equal_run_scores(runs_by_algo: dict[str, list[np.ndarray]], max_runs: int | None = None) -> dict[str, np.ndarray]:
-    """:func:`normalized_final_runs`' runs as rliable wants them: ``{algo: array (runs, tasks)}``, cut to the
-    algorithm's smallest run count over the tasks (its lowest seeds), and to ``max_runs`` when given (a comparison
-    fixed at a seed count before later seeds ran); an algorithm missing a task is left out."""
-    scores: dict[str, np.ndarray] = {}
-    for algo, per_task in runs_by_algo.items():
-        n_runs = min(len(values) for values in per_task)
-        if max_runs is not None:
-            n_runs = min(n_runs, max_runs)
-        if n_runs:
-            scores[algo] = np.stack([values[:n_runs] for values in per_task], axis=1)  # (runs, tasks)
-    return scores
-
-
-def normalized_final_scores(
-    table: pd.DataFrame, max_runs: int | None = None
-) -> tuple[dict[str, np.ndarray], list[tuple[str, float]]]:
-    """:func:`normalized_final_runs` cut by :func:`equal_run_scores` (``max_runs``: see there), and the tasks."""
-    runs_by_algo, tasks = normalized_final_runs(table)
-    return equal_run_scores(runs_by_algo, max_runs), tasks
-
-
-def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:
-    """Tasks (env, penalty) whose runs all ended at the same return: their min-max normalization has no range."""
-    task_range = final_rows(table).groupby(["env", "penalty"])["return"].agg(["min", "max"])
-    return [(str(env), float(c)) for (env, c), row in task_range.iterrows() if row["max"] == row["min"]]
-
-
-def iqm_with_intervals(
-    scores: dict[str, np.ndarray], reps: int = 2000, seed: int = 0
-) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """rliable's IQM per algorithm with 95 % stratified bootstrap intervals (``estimates``, ``intervals``); ``seed``
-    fixes the bootstrap draws, so that a regenerated table or figure reads the same."""
-    from rliable import library as rly
-    from rliable import metrics as rly_metrics
-
-    with seeded_numpy_global_generator(seed):
-        return rly.get_interval_estimates(scores, lambda x: np.array([rly_metrics.aggregate_iqm(x)]), reps=reps)
 
 
 def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None) -> Path:
@@ -392,54 +275,6 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         plt.close(figure)
         paths.append(path)
     return paths
-
-
-def q_value_picture(run_dir: Path, out: Path) -> Path | None:
-    """Figure 2: per-bin utilities over Pendulum's (angle, velocity) grid at each growth level, active bins outlined."""
-    snapshots = sorted(run_dir.glob("q_level*.npz"), key=lambda path: int(path.stem.removeprefix("q_level")))
-    if not snapshots:
-        return None
-    loaded: list[Any] = [np.load(path) for path in snapshots]
-    max_bins = int(loaded[0]["max_bins"])
-    bin_values = loaded[0].get("bin_values")  # older snapshots lack them
-    figure, axes = plt.subplots(
-        len(loaded), max_bins, figsize=(1.35 * max_bins + 1.2, 1.5 * len(loaded) + 1.0), squeeze=False, layout="constrained"
-    )
-    for row, snapshot in enumerate(loaded):
-        utilities, active = snapshot["utilities"], int(snapshot["active_bins"])
-        active_indices = set(np.linspace(0, max_bins - 1, active).round().astype(int).tolist())
-        low, high = np.percentile(utilities, [2, 98])
-        angles, velocities = snapshot["angles"], snapshot["velocities"]
-        extent = (velocities[0], velocities[-1], angles[0], angles[-1])
-        for column in range(max_bins):
-            axis = axes[row, column]
-            image = axis.imshow(utilities[:, :, column], origin="lower", aspect="auto", extent=extent, vmin=low, vmax=high)
-            axis.set_xticks([velocities[0], 0, velocities[-1]] if row == len(loaded) - 1 else [])
-            axis.set_yticks([angles[0], 0, angles[-1]] if column == 0 else [])
-            axis.tick_params(labelsize=6)
-            if column == 0:
-                axis.set_yticklabels(["-π", "0", "π"])
-            for spine in axis.spines.values():
-                spine.set_linewidth(2.5 if column in active_indices else 0.5)
-                spine.set_color("red" if column in active_indices else "grey")
-            if row == 0:
-                value = f"\na = {bin_values[column]:+.2f}" if bin_values is not None else ""
-                axis.set_title(f"bin {column}{value}", fontsize=7)
-        axes[row, 0].set_ylabel(f"{active} bins, step {int(snapshot['step'])}\nangle [rad]", fontsize=7)
-        colorbar = figure.colorbar(image, ax=axes[row, :].tolist(), shrink=0.9, pad=0.01)
-        colorbar.ax.tick_params(labelsize=6)
-        colorbar.set_label("utility Q(s, bin)", fontsize=7)
-    for axis in axes[-1, :]:
-        axis.set_xlabel("velocity [rad/s]", fontsize=6)
-    figure.suptitle(
-        f"{run_dir.name}: per-bin utilities over angle x angular velocity at the end of each level "
-        "(a: the bin's torque; red frame: active bins; colour scale per row)",
-        fontsize=8,
-    )
-    path = out / f"q_values_{run_dir.name}.png"
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
-    return path
 
 
 def plot_suite(table_path: Path, out: Path, warnings: list[str] | None = None) -> list[Path]:

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from sb3_gqn.experiments.plots import (
+from sb3_gqn.experiments.scores import (
     equal_run_scores,
     final_rows,
     iqm_with_intervals,

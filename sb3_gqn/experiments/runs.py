@@ -101,7 +101,7 @@ def run(
     import torch as th
     from rl_zoo3.exp_manager import ExperimentManager
 
-    from sb3_gqn.experiments.plots import save_q_snapshot
+    from sb3_gqn.experiments.q_values import save_q_snapshot
     from sb3_gqn.zoo.registration import register
 
     th.set_num_threads(threads)
