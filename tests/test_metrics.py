@@ -117,3 +117,27 @@ def test_bin_usage_of_a_bang_bang_square_wave_and_bad_input():
         bin_usage(np.zeros(5), np.array([1.0, 0.0]))
     with pytest.raises(ValueError, match="NaN"):
         bin_usage(np.array([0.0, np.nan, 1.0]), np.linspace(-1, 1, 3))
+
+
+class FlaggedEnv(ScriptedEnv):
+    """ScriptedEnv whose ``info[key]`` says success: in the first episode only at its final step, in the second only
+    at step 2 (a task solved midway and lost again does not count: the flag is read at the final step)."""
+
+    def __init__(self, key: str = "success"):
+        self.key, self.episode = key, 0
+
+    def reset(self, *, seed=None, options=None):
+        self.episode += 1
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action):
+        observation, reward, terminated, truncated, _ = super().step(action)
+        solved = self.t == 4 if self.episode == 1 else self.t == 2
+        return observation, reward, terminated, truncated, {self.key: float(solved)}
+
+
+@pytest.mark.parametrize("key", ["success", "solved"])
+def test_success_is_the_share_of_episodes_flagged_at_their_final_step(key):
+    figures = rollout_figures(ScriptedPolicy(), FlaggedEnv(key), n_episodes=2)
+    assert figures.success == 0.5
+    assert np.isnan(rollout_figures(ScriptedPolicy(), ScriptedEnv(), n_episodes=2).success)  # no flag: NaN, not 0

@@ -17,7 +17,16 @@ from stable_baselines3.common.vec_env import VecEnv
 from sb3_gqn.common.wrappers import ActionPenalty, check_finite_box
 
 #: Meta-World v3 tasks registered as ``sb3_gqn/metaworld-<task>`` (500-step episodes) when sb3_gqn is imported
-METAWORLD_TASKS = ("reach-v3", "push-v3", "pick-place-v3", "door-open-v3", "drawer-open-v3", "button-press-topdown-v3")
+METAWORLD_TASKS = (
+    "reach-v3",
+    "push-v3",
+    "pick-place-v3",
+    "door-open-v3",
+    "drawer-open-v3",
+    "button-press-topdown-v3",
+    "window-open-v3",
+    "button-press-v3",
+)
 
 # Env id prefixes whose suites register their envs on import.
 SUITE_MODULES = {

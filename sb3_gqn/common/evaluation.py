@@ -11,6 +11,7 @@ learning-curve callback that evaluates during training.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -23,16 +24,29 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from sb3_gqn.common.smoothness import SmoothnessFigures, control_frequency, episode_figures, normalized_actions
 
+#: ``info`` keys with which tasks flag success at a step: Meta-World's ``success``, MyoSuite's ``solved``
+SUCCESS_KEYS = ("success", "solved")
+
 
 @dataclass
 class Episode:
     """One rollout: its actions ``(T, M)`` (rescaled to ``[-1, 1]`` for a ``Box`` action space), its task return
-    (without the action penalty), the return the agent was trained on, and the reward the action penalty took."""
+    (without the action penalty), the return the agent was trained on, the reward the action penalty took, and whether
+    the task flagged success at the final step (``None`` for a task without the flag, see :data:`SUCCESS_KEYS`)."""
 
     actions: np.ndarray
     task_return: float
     return_: float
     penalty: float = 0.0
+    success: bool | None = None
+
+
+def final_success(info: dict[str, Any]) -> bool | None:
+    """The task's success flag in a step's ``info`` (:data:`SUCCESS_KEYS`), or ``None`` when it has none."""
+    for key in SUCCESS_KEYS:
+        if key in info:
+            return bool(info[key])
+    return None
 
 
 def rollout_episodes(
@@ -56,9 +70,8 @@ def rollout_episodes(
             penalty += float(info.get("action_penalty", 0.0))
             done = terminated or truncated
         taken = np.stack(actions)
-        episodes.append(
-            Episode(normalized_actions(taken, env.action_space) if box else taken, task_return, total_return, penalty)
-        )
+        scaled = normalized_actions(taken, env.action_space) if box else taken
+        episodes.append(Episode(scaled, task_return, total_return, penalty, final_success(info)))
     return episodes
 
 
@@ -129,7 +142,9 @@ def rollout_figures(
     freq = freq or control_frequency(env) or 1.0
     figures = [episode_figures(episode, freq) for episode in rollout_episodes(model, env, n_episodes, deterministic, seed)]
     means = np.mean([[getattr(figure, name) for name in _MEAN_FIELDS] for figure in figures], axis=0)
-    return SmoothnessFigures(*map(float, means), freq=float(freq), episodes=n_episodes)
+    flags = [figure.success for figure in figures if not math.isnan(figure.success)]
+    success = float(np.mean(flags)) if flags else math.nan
+    return SmoothnessFigures(*map(float, means), freq=float(freq), episodes=n_episodes, success=success)
 
 
 def growth_columns(model: Any) -> dict[str, Any]:

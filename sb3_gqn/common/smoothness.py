@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -115,7 +116,9 @@ class SmoothnessFigures:
     of the rescaled actions, i.e. the penalty with ``c = 1``; the reward lost to an ``ActionPenalty(c)``
     is ``c * P``), ``action_magnitude`` ``|a|`` (mean of ``|a_j|``), ``action_change`` ``|Δa|`` (mean of
     ``|a_j(t) - a_j(t-1)|``), ``smoothness`` SM (:func:`smoothness` per episode), ``return_`` the
-    return the agent was trained on (penalized if the env is), and the sampling frequency used.
+    return the agent was trained on (penalized if the env is), the sampling frequency used, and ``success``: the
+    share of episodes whose final step the task flagged as solved (Meta-World's ``info["success"]``, MyoSuite's
+    ``info["solved"]``), NaN for tasks without such a flag.
     """
 
     task_return: float
@@ -127,6 +130,7 @@ class SmoothnessFigures:
     episode_length: float
     freq: float
     episodes: int
+    success: float = math.nan
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -145,4 +149,5 @@ def episode_figures(episode: Episode, freq: float) -> SmoothnessFigures:
         episode_length=float(len(scaled)),
         freq=float(freq),
         episodes=1,
+        success=math.nan if episode.success is None else float(episode.success),
     )

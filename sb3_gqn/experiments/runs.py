@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import shutil
 import time
@@ -42,6 +43,7 @@ COLUMNS = [
     "growth_events",
     "deployed_bins",
     "deployments",
+    "success",
 ]
 
 
@@ -67,6 +69,7 @@ def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
         "growth_events": row["growth_events"],
         "deployed_bins": row["deployed_bins"],
         "deployments": row["deployments"],
+        "success": "" if math.isnan(row["success"]) else row["success"],
     }
 
 
