@@ -197,6 +197,40 @@ def test_readme_inference_script_runs_without_sb3_or_sb3_gqn(tmp_path):
         np.testing.assert_allclose(np.array(line.split(":")[1].split(), dtype=np.float32), expected, rtol=0, atol=0)
 
 
+def test_the_onnx_file_alone_deploys_from_a_fresh_folder(tmp_path):
+    """One self-contained file: no ``policy.onnx.data`` beside it, and a copy alone in another folder runs."""
+    model = GQN("MlpPolicy", "Pendulum-v1", seed=0)  # DecQN's 512 x 512 torso: about 1.1 MB of weights
+    export_onnx(model, tmp_path / "policy.onnx")
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["policy.onnx"]
+    assert (tmp_path / "policy.onnx").stat().st_size > 1_000_000  # the weights are inside
+    fresh = tmp_path / "robot"
+    fresh.mkdir()
+    (fresh / "policy.onnx").write_bytes((tmp_path / "policy.onnx").read_bytes())
+    (tmp_path / "policy.onnx").unlink()
+    batch = observations(model.observation_space, count=50)
+    np.testing.assert_array_equal(run_onnx(fresh / "policy.onnx", batch), model.predict(batch, deterministic=True)[0])
+    # asked for it, the weights go to a side file
+    export_onnx(model, tmp_path / "external.onnx", external_data=True)
+    assert (tmp_path / "external.onnx.data").is_file()
+
+
+@pytest.mark.parametrize("runtime", ["torchscript", "onnx"])
+@pytest.mark.parametrize(("env_id", "bins", "refused"), [("Pendulum-v1", (2, 9), np.nan), ("CartPole-v1", 2, -1)])
+def test_exported_policies_answer_a_non_finite_observation_with_no_valid_action(runtime, env_id, bins, refused, tmp_path):
+    """predict raises on NaN or inf; an exported file cannot raise, so such a row gets NaN (Box) or -1 (Discrete)."""
+    env = gym.make(env_id)
+    model = GQN("MlpPolicy", env, bins=bins, seed=0)
+    batch = observations(env.observation_space, count=4).astype(np.float32)
+    batch[1, 0], batch[2, 1], batch[3, 0] = np.nan, np.inf, -np.inf
+    export = export_onnx if runtime == "onnx" else export_torchscript
+    run = run_onnx if runtime == "onnx" else run_torchscript
+    actions = run(export(model, tmp_path / "policy"), batch)
+    np.testing.assert_array_equal(actions[:1], model.predict(batch[:1], deterministic=True)[0])
+    np.testing.assert_array_equal(actions[1:], np.full_like(actions[1:], refused))
+    with pytest.raises(ValueError, match="Non-finite observation from predict"):
+        model.predict(batch, deterministic=True)
+
+
 @pytest.mark.skipif(not th.cuda.is_available(), reason="no CUDA device on this machine")
 def test_training_acting_and_export_on_cuda(tmp_path):
     """device="cuda" needs no change anywhere: training, the lean acting path, predict and the (CPU) export."""

@@ -11,6 +11,10 @@ online network without), the current active-bin mask and the bin grid (see
 :class:`~sb3_gqn.export.policy.DeployedPolicy`): it returns the env's action (continuous values for a
 ``Box`` env, bin indices for ``Discrete``/``MultiDiscrete``) for a batch of observations, greedily, and matches
 ``model.predict(obs, deterministic=True)``. Export again after the model grows: the mask is baked in.
+
+Non-finite observations: ``predict`` raises on an observation holding NaN or +-inf. An exported file cannot raise, so
+it answers such a row with no valid action: NaN for a ``Box`` env, bin ``-1`` for ``Discrete``/``MultiDiscrete``.
+A controller checks ``isfinite`` (or ``>= 0``) on the output, as it would check any sensor fault.
 """
 
 from __future__ import annotations
@@ -50,8 +54,16 @@ def export_torchscript(model: GQN, path: str | Path, vec_normalize: VecNormalize
     return path
 
 
+#: ONNX files are protobuf messages, which cannot exceed 2 GiB; weights past this size go to a side file
+ONNX_EMBEDDED_LIMIT_BYTES = 2**31 - 2**27
+
+
 def export_onnx(
-    model: GQN, path: str | Path, vec_normalize: VecNormalize | None = None, opset_version: int | None = None
+    model: GQN,
+    path: str | Path,
+    vec_normalize: VecNormalize | None = None,
+    opset_version: int | None = None,
+    external_data: bool | None = None,
 ) -> Path:
     """Write ``model``'s greedy policy as an ONNX file (runs with ONNX Runtime, no PyTorch needed).
 
@@ -59,10 +71,16 @@ def export_onnx(
     take a batch (first dimension of any size) in the observation space's dtype; its output is ``action``.
     Needs the ``export`` extra (``onnx``, ``onnxscript``; ``onnxruntime`` to run it).
 
+    The file is self-contained: the weights are embedded in the graph, so ``path`` alone deploys. Only networks
+    whose weights exceed ONNX's 2 GiB message limit (:data:`ONNX_EMBEDDED_LIMIT_BYTES`) are written with their
+    weights in a side file ``<path>.data``, which must then travel with ``path``.
+
     :param model: a GQN or DecQN model
     :param path: the file to write (``.onnx``)
     :param vec_normalize: the ``VecNormalize`` the model was trained with, if any (see :func:`export_torchscript`)
     :param opset_version: ONNX opset (default: PyTorch's exporter default)
+    :param external_data: ``None`` (default): embed the weights unless they exceed the limit; ``True``: always
+        write the side file; ``False``: always embed (fails past the limit)
     :return: the path written
     """
     try:
@@ -70,6 +88,9 @@ def export_onnx(
     except ImportError as error:
         raise ImportError("export_onnx needs onnx and onnxscript: pip install 'sb3-gqn[export]' -c constraints.txt") from error
     policy = DeployedPolicy(model, vec_normalize)
+    if external_data is None:
+        weight_bytes = sum(tensor.numel() * tensor.element_size() for tensor in policy.state_dict().values())
+        external_data = weight_bytes > ONNX_EMBEDDED_LIMIT_BYTES
     example = policy.example_observation(batch_size=2)
     batch = th.export.Dim("batch")
     if isinstance(example, dict):
@@ -95,6 +116,7 @@ def export_onnx(
                 dynamic_shapes=dynamic_shapes,
                 opset_version=opset_version,
                 dynamo=True,
+                external_data=external_data,
                 verbose=False,
             )
     finally:

@@ -99,16 +99,33 @@ class DeployedPolicy(nn.Module):
         self.eval()
 
     def forward(self, observation: Observation) -> th.Tensor:
+        finite_rows = self.finite_rows(observation)
         if self.normalizer is not None:
             observation = self.normalizer(observation)
         utilities = critics_maximum(self.q_net, self.extra_q_nets, observation)
         bins = masked_argmax(utilities, self.active_bins_mask)  # (batch, action_dims)
         if self.continuous:
             values = self.bin_values.expand(bins.shape[0], -1, -1).gather(2, bins.unsqueeze(-1)).squeeze(-1)
-            return values.reshape((-1, *self.action_shape))
-        if self.discrete:
-            return bins.squeeze(-1)
-        return bins
+            actions = values.reshape((-1, *self.action_shape))
+            refused = th.full_like(actions, float("nan"))
+        else:
+            actions = bins.squeeze(-1) if self.discrete else bins
+            refused = th.full_like(actions, -1)
+        if finite_rows is None:
+            return actions
+        # a row whose observation holds NaN or +-inf gets no valid action: NaN (Box) or bin -1 (Discrete, MultiDiscrete)
+        return th.where(finite_rows.reshape((-1,) + (1,) * (actions.dim() - 1)), actions, refused)
+
+    @staticmethod
+    def finite_rows(observation: Observation) -> th.Tensor | None:
+        """Per batch row, whether every floating-point input value is finite (``None`` without float inputs)."""
+        tensors = list(observation.values()) if isinstance(observation, dict) else [observation]
+        finite: th.Tensor | None = None
+        for tensor in tensors:
+            if tensor.is_floating_point():
+                rows = th.isfinite(tensor).reshape(tensor.shape[0], -1).all(dim=1)
+                finite = rows if finite is None else finite & rows
+        return finite
 
     def example_observation(self, batch_size: int = 1) -> Observation:
         """A batch of observations sampled from the observation space, as tensors of its dtypes."""

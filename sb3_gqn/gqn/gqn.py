@@ -20,6 +20,7 @@ from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 from sb3_gqn.common.arguments import check_choice, check_learning_arguments
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
+from sb3_gqn.common.finite import as_batch, check_finite_observation
 from sb3_gqn.common.masking import EXPLORATION_MODES, active_bin_indices, epsilon_greedy
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.common.wrappers import BinGrid
@@ -33,11 +34,12 @@ from sb3_gqn.gqn.growth.schedules import (
 )
 from sb3_gqn.gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.gqn.q_network import DecoupledQNetwork
+from sb3_gqn.gqn.saving import SavedFiles
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
-class GQN(GrowingResolution, OffPolicyAlgorithm):
+class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     """
     Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose resolution grows from
     coarse to fine during training. Paper: https://arxiv.org/abs/2404.04253 (Seyde et al., L4DC 2024); the other
@@ -387,6 +389,7 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         :param deterministic: Whether or not to return deterministic actions.
         :return: the model's action and the next hidden state (used in recurrent policies)
         """
+        check_finite_observation(as_batch(observation, self.observation_space), "predict()'s input")
         actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
         if not deterministic:
             deployed_indices = active_bin_indices(self.bin_levels[-1], self.deployed_bins)
@@ -404,9 +407,15 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         dones: np.ndarray,
         infos: list[dict[str, Any]],
     ) -> None:
-        """Refuse non-finite rewards before they reach the replay buffer (they would poison every Q-value)."""
+        """Refuse non-finite rewards and observations before they reach the replay buffer (they would poison every
+        Q-value)."""
         if not np.all(np.isfinite(reward)):
             raise ValueError(f"The env returned a non-finite reward {reward} at step {self.num_timesteps}")
+        check_finite_observation(new_obs, f"the env's step {self.num_timesteps}")
+        for env_index, info in enumerate(infos):
+            if info.get("terminal_observation") is not None:
+                where = f"the env's step {self.num_timesteps} (terminal observation of env {env_index})"
+                check_finite_observation(as_batch(info["terminal_observation"], self.observation_space), where)
         super()._store_transition(replay_buffer, buffer_action, new_obs, reward, dones, infos)
 
     # ----------------------------------------------------------------------------------------------
@@ -490,8 +499,10 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         tb_log_name: str = "run",
         progress_bar: bool = False,
     ) -> tuple[int, BaseCallback]:
-        """Install the growth callback in front of the user's callbacks."""
+        """Install the growth callback in front of the user's callbacks; keep growth's clock when the counter resets."""
         env_will_reset = reset_num_timesteps or self._last_obs is None
+        if reset_num_timesteps:  # num_timesteps restarts at 0; growth_step goes on from the model's earlier steps
+            self.growth_step_offset += self.num_timesteps
         if callback is None:
             user_callbacks: list[BaseCallback] = []
         elif isinstance(callback, list):
@@ -504,6 +515,14 @@ class GQN(GrowingResolution, OffPolicyAlgorithm):
         total_timesteps, callback = super()._setup_learn(
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
         )
+        check_finite_observation(self._last_obs, "the env's reset")
+        if self.gradient_steps == 0:
+            warnings.warn(
+                "gradient_steps=0: learn() collects transitions but never updates the network (SB3's collect-only "
+                "setting). Pass gradient_steps=-1 (one update per env step collected) or a positive number to train.",
+                UserWarning,
+                stacklevel=3,
+            )
         if total_timesteps <= self.learning_starts:
             warnings.warn(
                 f"learn() ends at step {total_timesteps}, which does not exceed learning_starts={self.learning_starts}: "

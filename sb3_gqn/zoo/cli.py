@@ -82,21 +82,67 @@ def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
     return [*kept, "-params", f"n_envs:{int(n_envs)}"]
 
 
-MISSING_ENTRY_HINT = """\
-This env has no entry in the hyperparameter file. Write one (rl-zoo3's YAML format) and pass the file with
--conf my_hyperparams.yml, e.g. for a torque-controlled task:
+def entry_template(env_id: str, action_space: Any | None = None) -> str:
+    """A hyperparameter entry, in rl-zoo3's YAML format, that trains GQN on ``env_id`` as printed.
 
-my-env-v0:
-  n_timesteps: !!float 2e5
-  policy: 'MlpPolicy'
-  bins: [2, 9]          # 9 -> 65 for velocity control
-  growth: 'adaptive'
-  train_freq: 2
-  env_wrapper:
-    - sb3_gqn.common.wrappers.ActionPenalty:
-        coef: 0.1
+    For a ``Box`` action space: the growing bins and the action penalty. For ``Discrete(n)`` (and ``MultiDiscrete``
+    with n choices everywhere): the env's own n choices, growing from 2 when n is a nested level count (3, 5, 9, ...),
+    and no penalty (it needs a ``Box``). ``action_space`` is read from the env when not given; an env that cannot be
+    made gets the ``Box`` entry.
+    """
+    import numpy as np
+    from gymnasium import spaces
 
-How to choose bins, growth, the penalty and train_freq: README, "Train GQN on your own task"."""
+    if action_space is None:
+        try:
+            import gymnasium as gym
+
+            from sb3_gqn.common.envs import register_envs
+
+            register_envs()
+            env = gym.make(env_id)
+            action_space = env.action_space
+            env.close()
+        except Exception:  # the template is a hint: an env that cannot be made gets the Box entry
+            action_space = None
+    lines = [f"{env_id}:", "  n_timesteps: !!float 2e5", "  policy: 'MlpPolicy'"]
+    choices: int | None = None
+    if isinstance(action_space, spaces.Discrete):
+        choices = int(action_space.n)
+    elif isinstance(action_space, spaces.MultiDiscrete) and len(set(np.ravel(action_space.nvec).tolist())) == 1:
+        choices = int(np.ravel(action_space.nvec)[0])
+    if choices is None:
+        lines += [
+            "  bins: [2, 9]          # 9 -> 65 for velocity or position targets",
+            "  growth: 'adaptive'",
+            "  train_freq: 2",
+            "  env_wrapper:",
+            "    - sb3_gqn.common.wrappers.ActionPenalty:",
+            "        coef: 0.1",
+        ]
+    elif choices >= 3 and ((choices - 1) & (choices - 2)) == 0:  # 3, 5, 9, 17, ...: nested levels from 2
+        lines += [f"  bins: [2, {choices}]         # the env's {choices} choices, opened from 2", "  growth: 'adaptive'"]
+        lines += ["  train_freq: 2"]
+    else:
+        lines += [f"  bins: {choices}              # the env's {choices} choices, static"]
+        lines += ["  growth: null", "  train_freq: 2"]
+    return "\n".join(lines)
+
+
+def missing_entry_hint(env_id: str) -> str:
+    """What to do when the hyperparameter file has no entry for ``env_id``: an entry that works for it, and where to
+    read how to choose its values."""
+    return (
+        "This env has no entry in the hyperparameter file. Write one (rl-zoo3's YAML format) and pass the file with\n"
+        f"-conf my_hyperparams.yml, e.g. for this env:\n\n{entry_template(env_id)}\n\n"
+        'How to choose bins, growth, the penalty and train_freq: README, "Train GQN on your own task".'
+    )
+
+
+UNQUOTED_STRING_HINT = (
+    "-params values are Python expressions (rl-zoo3 evaluates them): quote strings inside the shell's quotes,\n"
+    'e.g. -params growth:"\'linear\'" exploration:"\'per_dimension\'" bins:"(2, 9)"'
+)
 
 
 def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
@@ -120,7 +166,9 @@ def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: st
         message = str(error).strip().splitlines()[0] if str(error).strip() else ""
         print(f"{prog}: error: {type(error).__name__}: {message}", file=sys.stderr)
         if message.startswith("Hyperparameters not found"):
-            print(MISSING_ENTRY_HINT, file=sys.stderr)
+            print(missing_entry_hint(_option_value(sys.argv[1:], "--env") or "my-env-v0"), file=sys.stderr)
+        if isinstance(error, (NameError, SyntaxError)) and _option_value(sys.argv[1:], "-params", "--hyperparams"):
+            print(UNQUOTED_STRING_HINT, file=sys.stderr)
         return 1
     finally:
         sys.argv = saved_argv

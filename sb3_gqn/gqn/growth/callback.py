@@ -27,7 +27,7 @@ class GrowthCallback(BaseCallback):
     def _on_training_start(self) -> None:
         schedule = self.model.growth_schedule
         if isinstance(schedule, AdaptiveGrowth):
-            schedule.start(self.model.n_envs, self.env_was_reset, self.model.num_timesteps)
+            schedule.start(self.model.n_envs, self.env_was_reset, self.model.growth_step)
         self.model.logger.record("growth/active_bins", self.model.active_bins)
 
     def _on_step(self) -> bool:
@@ -38,7 +38,7 @@ class GrowthCallback(BaseCallback):
         if model.growth == "linear":
             target = linear_growth_level(model.num_timesteps, model._total_timesteps, len(model.bin_levels))
             if target > model.growth_level:
-                model.grow(target, reason=f"linear schedule at step {model.num_timesteps}")
+                model.grow(target, reason=f"linear schedule at step {model.growth_step}")
             return True
         schedule = model.growth_schedule
         assert isinstance(schedule, AdaptiveGrowth), "growth='adaptive' always has its AdaptiveGrowth state"
@@ -47,19 +47,19 @@ class GrowthCallback(BaseCallback):
         rewards = self.locals["rewards"]
         if model._vec_normalize_env is not None:
             rewards = model._vec_normalize_env.get_original_reward()
-        for decision in schedule.observe(rewards, self.locals["dones"], model.num_timesteps):
+        for decision in schedule.observe(rewards, self.locals["dones"], model.growth_step):
             model.logger.record("growth/return", decision.current_return)
             if decision.threshold is not None:
                 model.logger.record("growth/threshold", decision.threshold)
             if decision.probation_reference is not None:
                 model.logger.record("growth/probation_return", decision.current_return)
             if decision.deploy:
-                model.deploy(reason=f"{decision.describe_probation()} at step {model.num_timesteps}")
+                model.deploy(reason=f"{decision.describe_probation()} at step {model.growth_step}")
             if decision.grow and model.growth_level < last_level:
                 schedule.start_probation(decision.current_return)
                 model.grow(
                     model.growth_level + 1,
-                    reason=f"{schedule.returns_source} {decision.describe()} at step {model.num_timesteps}",
+                    reason=f"{schedule.returns_source} {decision.describe()} at step {model.growth_step}",
                     probation=schedule.on_probation,
                 )
             if model.growth_level >= last_level and not schedule.on_probation:

@@ -37,6 +37,9 @@ class GrowingResolution:
     growth_schedule: AdaptiveGrowth | None
     policy: GQNPolicy
     num_timesteps: int
+    #: env steps of earlier ``learn()`` calls whose counter was reset (``reset_num_timesteps=True``): growth counts
+    #: the model's whole life, so its events stay in step order across save, load and reset counters
+    growth_step_offset: int = 0
     verbose: int
     _active_bin_indices: np.ndarray
     _learning_bins_mask: th.Tensor
@@ -45,6 +48,12 @@ class GrowingResolution:
     def active_bins(self) -> int:
         """Current resolution: number of active bins per action dimension (the level learned and explored)."""
         return self.bin_levels[self.growth_level]
+
+    @property
+    def growth_step(self) -> int:
+        """Env steps over the model's whole life: the clock of :attr:`growth_events`, :attr:`deployments` and the
+        adaptive schedule (``num_timesteps`` restarts at 0 when ``learn`` resets it; this does not)."""
+        return int(self.growth_step_offset + self.num_timesteps)
 
     @property
     def deployed_level(self) -> int:
@@ -74,7 +83,7 @@ class GrowingResolution:
             "active_bins": self.active_bins,
             "deployed_bins": self.deployed_bins,
             "level": self.growth_level,
-            "last_growth_step": self.num_timesteps,
+            "last_growth_step": self.growth_step,
         }
         for key in keys:
             self.logger.record(f"growth/{key}", values[key])  # type: ignore[attr-defined]
@@ -110,9 +119,9 @@ class GrowingResolution:
             if self.growth_schedule is not None:
                 self.growth_schedule.end_probation()
         self._apply_growth_level()
-        self.growth_events.append((int(self.num_timesteps), int(self.active_bins)))
+        self.growth_events.append((self.growth_step, int(self.active_bins)))
         if not probation:
-            self.deployments.append((int(self.num_timesteps), int(self.active_bins)))
+            self.deployments.append((self.growth_step, int(self.active_bins)))
         self._record_levels("active_bins", "deployed_bins", "level", "last_growth_step")
         if self.verbose >= 1:
             on_probation = f"; predict stays at {self.deployed_bins} bins on probation" if probation else ""
@@ -125,7 +134,7 @@ class GrowingResolution:
         previous_bins = self.deployed_bins
         self._deployed_level = None
         self._apply_growth_level()
-        self.deployments.append((int(self.num_timesteps), int(self.deployed_bins)))
+        self.deployments.append((self.growth_step, int(self.deployed_bins)))
         self._record_levels("deployed_bins")
         if self.verbose >= 1:
             print(f"GQN deployed: predict acts on {previous_bins} -> {self.deployed_bins} bins per dimension ({reason})")
