@@ -36,6 +36,7 @@ docs: venv
 benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
+	$(BIN)/python benchmarks/bad_input.py
 
 # The results page (docs/results/README.md), the README's results table and docs/results/main's figures, from the
 # committed docs/results tables
