@@ -228,6 +228,10 @@ class LearningCurveCallback(BaseCallback):
             self.on_progress(self.num_timesteps)
         return True
 
+    def seconds_so_far(self) -> float:
+        """Training seconds up to now, evaluations excluded (what the next row's ``train_seconds`` would start from)."""
+        return self.train_seconds + (time.perf_counter() - self.started if self.started else 0.0)
+
     def _on_training_end(self) -> None:
         if self.num_timesteps > self.last_eval:
             self.evaluate_now()

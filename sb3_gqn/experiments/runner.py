@@ -12,7 +12,8 @@ budget given here), evaluates greedily every --eval-freq steps with sb3_gqn.comm
 and writes <out>/runs/<run>/curve.csv; done.json marks it finished. Runs go to parallel
 processes (--jobs, default the core count, torch threads split between them). A second invocation
 skips finished runs (a done.json, or the run's rows up to its budget in <out>/results.csv, so a
-committed table can be extended by a later invocation) and restarts interrupted ones from scratch. At the
+committed table can be extended by a later invocation) and resumes interrupted ones from their newest whole
+checkpoint (every --checkpoint-freq env steps; an interruption costs at most that many steps). At the
 end <out>/results.csv holds every evaluation of every run of the suite (algo, env, penalty, seed, step,
 return, task return, wall time, smoothness figures, growth events) and sb3_gqn.experiments.plots draws the figures into <out>/.
 """
@@ -27,6 +28,7 @@ from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoCo off any GL backend
 
+from sb3_gqn.experiments.checkpoints import DEFAULT_CHECKPOINT_FREQ, KEEP
 from sb3_gqn.experiments.processes import run_in_processes
 from sb3_gqn.experiments.runs import collect, is_finished, progress_line, recorded_rows, run
 from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, VARIANTS, RunSpec, load_variants, untrained_runs
@@ -70,6 +72,21 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     )
     parser.add_argument("--out", default="results/benchmark", help="output folder")
     parser.add_argument(
+        "--checkpoint-freq",
+        type=int,
+        default=DEFAULT_CHECKPOINT_FREQ,
+        metavar="N",
+        help=f"env steps between a run's checkpoints (model, replay buffer, curve, random states; the last {KEEP} kept); "
+        f"the same command resumes unfinished runs from them. 0: none, interrupted runs start again "
+        f"(default {DEFAULT_CHECKPOINT_FREQ})",
+    )
+    parser.add_argument(
+        "--checkpoint-dir",
+        type=Path,
+        help="folder for the checkpoints (default: <out>/runs/<run>/checkpoints); with --ray-address, storage every node "
+        "sees, so a retried task resumes",
+    )
+    parser.add_argument(
         "--ray-address",
         help="run every run as a task on this Ray cluster ('auto': the cluster this process runs in; needs the ray extra); "
         "the driver alone writes --out",
@@ -85,6 +102,8 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
             setattr(args, key, defaults[key])
     if args.eval_freq is None:
         args.eval_freq = max(args.steps // 10, 1)
+    if args.checkpoint_freq < 0:
+        parser.error(f"--checkpoint-freq must be >= 0, got {args.checkpoint_freq}")
     return args
 
 
@@ -113,6 +132,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         for spec in specs:
             print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
         return 0
+    checkpointing = (args.checkpoint_freq or None, args.checkpoint_dir)
     jobs = max(1, min(args.jobs, len(pending) or 1))
     threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)
     if pending and args.ray_address:
@@ -135,7 +155,10 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         out.mkdir(parents=True, exist_ok=True)
         by_name = {spec.name: spec for spec in pending}
         run_in_processes(
-            [(spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads)) for spec in pending],
+            [
+                (spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads, None, *checkpointing))
+                for spec in pending
+            ],
             jobs,
             on_finished=lambda name: print(f"finished {name}"),
             on_wait=lambda names: print(

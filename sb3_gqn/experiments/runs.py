@@ -12,6 +12,7 @@ import math
 import os
 import shutil
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
@@ -20,6 +21,13 @@ from typing import Any
 from filelock import FileLock
 
 from sb3_gqn.common.evaluation import LearningCurveCallback
+from sb3_gqn.experiments.checkpoints import (
+    RunCheckpointCallback,
+    checkpoint_steps,
+    newest_whole_checkpoint,
+    read_state,
+    restore_random_state,
+)
 from sb3_gqn.experiments.variants import RunSpec, make_eval_env, penalized_wrappers, run_overrides
 from sb3_gqn.zoo.hyperparams import shipped_entry, shipped_hyperparams
 
@@ -89,8 +97,15 @@ def run(
     eval_episodes: int,
     threads: int,
     report_progress: Callable[[int], None] | None = None,
+    checkpoint_freq: int | None = None,
+    checkpoint_dir: Path | None = None,
 ) -> str:
     """Train and evaluate one run in this process; return its name. Skips a finished run.
+
+    With ``checkpoint_freq`` (env steps), the run writes checkpoints (:mod:`~sb3_gqn.experiments.checkpoints`) into
+    ``<checkpoint_dir>/<run>/`` (default: ``<out>/runs/<run>/checkpoints/``), and an interrupted run resumes from its
+    newest whole one; without one it starts again from scratch. ``done.json`` records ``resumed_from``: the steps
+    of every checkpoint the run resumed from.
 
     ``report_progress`` (optional) is called with the run's env steps every 500 steps (the Ray runner
     forwards them to the driver; locally the driver reads ``runs/<run>/progress``).
@@ -98,9 +113,21 @@ def run(
     run_dir = out / "runs" / spec.name
     if (run_dir / "done.json").is_file():
         return spec.name
-    if run_dir.exists():  # interrupted earlier: start again from scratch
-        shutil.rmtree(run_dir)
-    run_dir.mkdir(parents=True)
+    checkpoints = (checkpoint_dir / spec.name) if checkpoint_dir is not None else run_dir / "checkpoints"
+    checkpoint = newest_whole_checkpoint(checkpoints) if checkpoint_freq else None
+    if checkpoint is None:
+        if run_dir.exists():  # interrupted earlier without a checkpoint: start again from scratch
+            if checkpoint_freq and checkpoint_steps(checkpoints):
+                warnings.warn(f"{spec.name}: no whole checkpoint in {checkpoints}: starting again from scratch", stacklevel=2)
+            shutil.rmtree(run_dir)
+        shutil.rmtree(checkpoints, ignore_errors=True)
+        run_dir.mkdir(parents=True)
+        resumed_from: list[int] = []
+    else:
+        state = read_state(checkpoint)
+        resumed_from = [*state.get("resumed_from", []), int(checkpoint.name[5:])]
+        shutil.copyfile(checkpoint / "curve.csv", run_dir / "curve.csv")  # rows after the checkpoint come again
+        shutil.rmtree(run_dir / "zoo", ignore_errors=True)
     import torch as th
     from rl_zoo3.exp_manager import ExperimentManager
 
@@ -111,6 +138,8 @@ def run(
     register()
     zoo_algo, overrides = run_overrides(spec)
     wrappers = penalized_wrappers(shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
+    if checkpoint_freq:
+        wrappers = [*wrappers, "sb3_gqn.experiments.checkpoints.ReplayableResets"]
     manager = ExperimentManager(
         argparse.Namespace(),
         zoo_algo,
@@ -123,6 +152,7 @@ def run(
         verbose=0,
         log_interval=-1,
         config=str(shipped_hyperparams(zoo_algo)),
+        trained_agent=str(checkpoint / "model.zip") if checkpoint is not None else "",
     )
     model, _ = manager.setup_experiment()  # type: ignore[misc]
     eval_env = make_eval_env(spec)
@@ -140,15 +170,34 @@ def run(
         on_row=lambda row: append_row(run_dir / "curve.csv", curve_row(spec, row)),
         on_progress=on_progress,
     )
-    manager.callbacks.append(curve)
+    callbacks: list[Any] = [*manager.callbacks, curve]
     if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
-        manager.callbacks.append(save_q_snapshot(run_dir))
+        callbacks.append(save_q_snapshot(run_dir))
+    if checkpoint_freq:
+
+        def checkpoint_state() -> dict[str, Any]:
+            return {"train_seconds": curve.seconds_so_far(), "resumed_from": resumed_from}
+
+        callbacks.append(RunCheckpointCallback(checkpoints, checkpoint_freq, run_dir / "curve.csv", checkpoint_state))
+    if checkpoint is not None:
+        curve.train_seconds = float(state.get("train_seconds", 0.0))
+        restore_random_state(model, state["random"])
     started = time.perf_counter()
-    manager.learn(model)
+    try:  # rl-zoo3's learn restarts the step counter; a resumed run continues it up to the budget
+        model.learn(spec.steps - model.num_timesteps, callback=callbacks, reset_num_timesteps=checkpoint is None)
+    finally:
+        model.env.close()
     model.save(run_dir / "model.zip")
-    summary = {"run": spec.name, "spec": asdict(spec), "wall_seconds": time.perf_counter() - started, "threads": threads}
+    summary = {
+        "run": spec.name,
+        "spec": asdict(spec),
+        "wall_seconds": time.perf_counter() - started,
+        "threads": threads,
+        "resumed_from": resumed_from,
+    }
     (run_dir / "done.json.tmp").write_text(json.dumps(summary, indent=2))
     os.replace(run_dir / "done.json.tmp", run_dir / "done.json")
+    shutil.rmtree(checkpoints, ignore_errors=True)  # the finished run's model.zip supersedes them
     return spec.name
 
 

@@ -1,0 +1,115 @@
+"""Runs that survive: the comparison runner's checkpoints, resuming after a kill, damaged checkpoints, and a resumed
+run that follows the uninterrupted one exactly."""
+
+import csv
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import torch as th
+
+from sb3_gqn import GQN
+from sb3_gqn.experiments.checkpoints import KEEP, RunCheckpointCallback, checkpoint_steps, newest_whole_checkpoint
+from sb3_gqn.experiments.runs import run
+from sb3_gqn.experiments.variants import RunSpec
+from tests.envs import DecliningEnv
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+STEPS, FREQ, EVAL_FREQ = 1_600, 800, 400  # Pendulum's episodes are 200 steps: each checkpoint is at an episode end
+SPEC = RunSpec("gqn-adaptive", "Pendulum-v1", 0.1, 0, STEPS)
+RUN = f"""
+import sys
+from pathlib import Path
+from sb3_gqn.experiments.runs import run
+from sb3_gqn.experiments.variants import RunSpec
+run(RunSpec("gqn-adaptive", "Pendulum-v1", 0.1, 0, {STEPS}), Path(sys.argv[1]), {EVAL_FREQ}, 2, 1, checkpoint_freq={FREQ})
+"""
+
+
+def kill_after_first_checkpoint(out: Path) -> None:
+    """Start the run in a process and SIGKILL it once its first checkpoint is whole."""
+    process = subprocess.Popen([sys.executable, "-c", RUN, str(out)], cwd=REPOSITORY, stdout=subprocess.DEVNULL)
+    folder = out / "runs" / SPEC.name / "checkpoints"
+    deadline = time.monotonic() + 300
+    while newest_whole_checkpoint(folder) is None:
+        assert process.poll() is None, "the run ended before its first checkpoint"
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert not (out / "runs" / SPEC.name / "done.json").exists()
+
+
+def curve_steps(out: Path) -> list[int]:
+    with open(out / "runs" / SPEC.name / "curve.csv", newline="") as handle:
+        return [int(row["step"]) for row in csv.DictReader(handle)]
+
+
+def final_parameters(out: Path) -> dict[str, th.Tensor]:
+    return dict(GQN.load(out / "runs" / SPEC.name / "model.zip").policy.state_dict())
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("uninterrupted")
+    th.set_num_threads(1)
+    run(SPEC, out, EVAL_FREQ, 2, 1, checkpoint_freq=FREQ)
+    return out
+
+
+def test_a_killed_run_resumes_from_its_checkpoint_and_follows_the_uninterrupted_run(tmp_path, uninterrupted):
+    kill_after_first_checkpoint(tmp_path)
+    th.set_num_threads(1)
+    run(SPEC, tmp_path, EVAL_FREQ, 2, 1, checkpoint_freq=FREQ)  # the same call resumes it
+    done = json.loads((tmp_path / "runs" / SPEC.name / "done.json").read_text())
+    assert done["resumed_from"] and done["resumed_from"][0] >= FREQ
+    assert json.loads((uninterrupted / "runs" / SPEC.name / "done.json").read_text())["resumed_from"] == []
+    # every evaluation once, up to the budget; the final model at the budget
+    assert curve_steps(tmp_path) == list(range(EVAL_FREQ, STEPS + 1, EVAL_FREQ)) == curve_steps(uninterrupted)
+    resumed = GQN.load(tmp_path / "runs" / SPEC.name / "model.zip")
+    assert resumed.num_timesteps == STEPS
+    # resumed at an episode end on one torch thread: the same parameters and evaluations as without the kill
+    expected = final_parameters(uninterrupted)
+    assert all(th.equal(value, expected[key]) for key, value in resumed.policy.state_dict().items())
+    with open(tmp_path / "runs" / SPEC.name / "curve.csv") as a, open(uninterrupted / "runs" / SPEC.name / "curve.csv") as b:
+        for row_a, row_b in zip(csv.DictReader(a), csv.DictReader(b)):
+            assert row_a["return"] == row_b["return"] and row_a["growth_events"] == row_b["growth_events"]
+    assert not (tmp_path / "runs" / SPEC.name / "checkpoints").exists()  # the finished run's model supersedes them
+
+
+def test_a_torn_newest_checkpoint_falls_back_to_the_one_before(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8]), learning_starts=10, train_freq=1)
+    callback = RunCheckpointCallback(tmp_path, freq=10)
+    model.learn(60, callback=callback)
+    # DecliningEnv's episodes end every 5 steps, so each checkpoint is at the first rollout after 10, 20, ...
+    assert callback.written == [10, 20, 30, 40, 50, 60][: len(callback.written)] and len(callback.written) >= 4
+    assert checkpoint_steps(tmp_path) == sorted(callback.written, reverse=True)[:KEEP]  # the last two kept
+    newest, before = checkpoint_steps(tmp_path)
+    (tmp_path / f"step_{newest}" / "model.zip").write_bytes(b"torn")
+    with pytest.warns(UserWarning, match=f"step_{newest} is damaged"):
+        assert newest_whole_checkpoint(tmp_path) == tmp_path / f"step_{before}"
+    (tmp_path / f"step_{before}" / "complete").unlink()  # a write that never finished
+    with pytest.warns(UserWarning, match="damaged"):
+        assert newest_whole_checkpoint(tmp_path) is None
+
+
+def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):
+    spec = RunSpec("gqn-adaptive", "Pendulum-v1", 0.1, 0, 400)
+    run_dir = tmp_path / "runs" / spec.name
+    (run_dir / "checkpoints" / "step_200").mkdir(parents=True)
+    (run_dir / "checkpoints" / "step_200" / "model.zip").write_bytes(b"torn")
+    (run_dir / "curve.csv").write_text("stale rows\n")
+    with pytest.warns(UserWarning, match="starting again from scratch"):
+        run(spec, tmp_path, 200, 1, 1, checkpoint_freq=FREQ)
+    assert json.loads((run_dir / "done.json").read_text())["resumed_from"] == []
+    with open(run_dir / "curve.csv", newline="") as handle:
+        assert [int(row["step"]) for row in csv.DictReader(handle)] == [200, 400]
+
+
+def test_checkpoint_frequency_must_be_positive():
+    with pytest.raises(ValueError, match="checkpoint frequency must be >= 1"):
+        RunCheckpointCallback(Path("."), freq=0)
