@@ -37,6 +37,7 @@ benchmark: venv
 	$(BIN)/python benchmarks/throughput.py
 	$(BIN)/python benchmarks/replay.py
 	$(BIN)/python benchmarks/bad_input.py
+	$(BIN)/python benchmarks/checkpoints.py
 
 # The results page (docs/results/README.md), the README's results table and docs/results/main's figures, from the
 # committed docs/results tables

@@ -113,3 +113,24 @@ def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):
 def test_checkpoint_frequency_must_be_positive():
     with pytest.raises(ValueError, match="checkpoint frequency must be >= 1"):
         RunCheckpointCallback(Path("."), freq=0)
+
+
+def test_rl_zoo_continues_from_a_checkpoint_with_its_replay_buffer_and_growth(tmp_path):
+    from sb3_gqn.zoo.cli import train
+
+    first = ["--algo", "gqn", "--env", "Pendulum-v1", "--seed", "0", "-f", str(tmp_path / "first")]
+    assert train([*first, "-n", "1200", "--save-freq", "600", "--save-replay-buffer"]) == 0
+    folder = tmp_path / "first" / "gqn" / "Pendulum-v1_1"
+    assert (folder / "rl_model_replay_buffer_600_steps.pkl").is_file()  # rl-zoo3 alone saves no buffer per checkpoint
+    checkpoint = GQN.load(folder / "rl_model_600_steps.zip")
+    # the linear schedule over 1200 steps opened 3 and 5 bins at 240 and 480 (g / 5 of the budget)
+    assert checkpoint.growth_events == [(240, 3), (480, 5)] and checkpoint.num_timesteps == 600
+    second = ["--algo", "gqn", "--env", "Pendulum-v1", "--seed", "0", "-f", str(tmp_path / "second")]
+    assert train([*second, "-n", "600", "-i", str(folder / "rl_model_600_steps.zip"), "--save-replay-buffer"]) == 0
+    continued = GQN.load(tmp_path / "second" / "gqn" / "Pendulum-v1_1" / "Pendulum-v1.zip")
+    continued.load_replay_buffer(tmp_path / "second" / "gqn" / "Pendulum-v1_1" / "replay_buffer.pkl")
+    # SB3's CheckpointCallback saves before it stores the step's transition: 599 + 600 transitions
+    assert continued.replay_buffer.pos == 1_199
+    # rl-zoo3 restarts num_timesteps; growth goes on from step 600 of the model's life (600 + 600 * 3 / 5)
+    assert (continued.num_timesteps, continued.growth_step) == (600, 1_200)
+    assert continued.growth_events == [(240, 3), (480, 5), (960, 9)]

@@ -17,6 +17,7 @@ import pytest
 
 ray = pytest.importorskip("ray")
 
+from sb3_gqn.experiments.checkpoints import newest_whole_checkpoint  # noqa: E402
 from sb3_gqn.experiments.ray_runner import progress_board_name  # noqa: E402
 from sb3_gqn.experiments.runner import main  # noqa: E402
 
@@ -111,30 +112,34 @@ def test_ray_suite_writes_the_same_rows_and_returns_as_a_local_run(cluster, tmp_
     assert main([*suite, "--ray-address", cluster.address, "--out", str(tmp_path / "ray"), "--list"]) == 0
 
 
-def test_a_killed_worker_node_costs_a_retry_not_a_run(cluster, tmp_path):
-    out = tmp_path / "suite"
+def test_a_killed_worker_node_costs_a_retry_that_resumes_from_the_last_checkpoint(cluster, tmp_path):
+    out, shared = tmp_path / "suite", tmp_path / "shared"  # one machine: a local folder is storage every node sees
     algos = ["gqn-linear", "decqn-2", "decqn-9"]
     suite = ["--algos", *algos, *SUITE, "--steps", "3000", "--eval-freq", "1000", "--out", str(out)]
+    suite += ["--checkpoint-freq", "1000", "--checkpoint-dir", str(shared)]
     ray.init(address=cluster.address, logging_level="WARNING", log_to_driver=False)
     head = next(node["NodeID"] for node in ray.nodes() if "node:__internal_head__" in node["Resources"])
     results: list[int] = []
     driver = threading.Thread(target=lambda: results.append(main([*suite, "--ray-address", cluster.address])))
     driver.start()
-    # Wait until a run is in flight on the worker node, then kill that node (raylet, workers, everything)
-    deadline = time.monotonic() + 120
+    # Wait until a run on the worker node has written a whole checkpoint, then kill that node (raylet, workers, all)
+    deadline = time.monotonic() + 240
+    on_worker: str | None = None
     while time.monotonic() < deadline:
         try:
             attempts = ray.get(ray.get_actor(progress_board_name(out)).nodes.remote())
         except ValueError:  # the driver has not created the board yet
             attempts = {}
-        if any(head not in nodes for nodes in attempts.values()):
+        on_worker = next((name for name, nodes in attempts.items() if head not in nodes), None)
+        if on_worker is not None and newest_whole_checkpoint(shared / on_worker) is not None:
             break
         time.sleep(0.5)
     else:
-        pytest.fail("no run started on the worker node")
-    time.sleep(2.0)  # let it train for a moment
+        pytest.fail("no run on the worker node wrote a checkpoint")
     cluster.kill_worker_node()
-    driver.join(timeout=300)
+    killed = time.monotonic()
+    driver.join(timeout=600)
+    print(f"driver finished {time.monotonic() - killed:.0f} s after the kill")
     assert not driver.is_alive() and results == [0]
 
     rows = table(out)
@@ -142,4 +147,6 @@ def test_a_killed_worker_node_costs_a_retry_not_a_run(cluster, tmp_path):
     assert sorted(runs) == sorted((algo, step) for algo in algos for step in (1000, 2000, 3000))  # each exactly once
     attempts = json.loads((out / "ray_attempts.json").read_text())
     retried = [name for name, nodes in attempts.items() if len(nodes) > 1]
-    assert len(retried) == 1 and attempts[retried[0]][-1] == head  # retried on the surviving node
+    assert retried == [on_worker] and attempts[on_worker][-1] == head  # retried on the surviving node
+    done = json.loads((out / "runs" / on_worker / "done.json").read_text())
+    assert done["resumed_from"] and done["resumed_from"][0] >= 1000  # from its checkpoint, not from step 0

@@ -9,7 +9,9 @@ driver leaves no half-written finished run), then ``results.csv`` and the plots 
 Progress (runs done / total, each running run's steps) reaches the driver through a small actor.
 
 Faults: a task whose worker process or node dies is retried elsewhere by Ray (``--ray-retries``, default 3);
-only the attempt that returns writes files, so every run appears in ``results.csv`` once. A driver killed
+only the attempt that returns writes files, so every run appears in ``results.csv`` once. With ``--checkpoint-dir`` on
+storage every node sees (NFS, or a local folder on a one-machine cluster), the retry resumes from the run's last
+checkpoint there (``done.json``'s ``resumed_from``); without it, the retry starts at step 0. A driver killed
 and restarted resubmits only the runs without ``done.json`` or recorded rows (the runner's resume).
 """
 
@@ -65,14 +67,32 @@ def _progress_board(name: str) -> Any:
     return ProgressBoard.options(name=name, scheduling_strategy=here).remote()
 
 
-def train_remotely(spec: RunSpec, eval_freq: int, eval_episodes: int, threads: int, board: Any) -> dict[str, bytes]:
-    """The body of a Ray task: one run trained in a temporary folder; returns its files by relative path."""
+def train_remotely(
+    spec: RunSpec,
+    eval_freq: int,
+    eval_episodes: int,
+    threads: int,
+    board: Any,
+    checkpoint_freq: int | None = None,
+    checkpoint_dir: Path | None = None,
+) -> dict[str, bytes]:
+    """The body of a Ray task: one run trained in a temporary folder; returns its files by relative path. With
+    ``checkpoint_dir`` on storage every node sees, a retried task resumes from the run's last checkpoint there."""
     import ray
 
     board.started.remote(spec.name, ray.get_runtime_context().get_node_id())
     with tempfile.TemporaryDirectory(prefix="sb3_gqn_run_") as folder:
         out = Path(folder)
-        run(spec, out, eval_freq, eval_episodes, threads, report_progress=lambda steps: board.report.remote(spec.name, steps))
+        run(
+            spec,
+            out,
+            eval_freq,
+            eval_episodes,
+            threads,
+            report_progress=lambda steps: board.report.remote(spec.name, steps),
+            checkpoint_freq=checkpoint_freq,
+            checkpoint_dir=checkpoint_dir,
+        )
         run_dir = out / "runs" / spec.name
         return {str(path.relative_to(run_dir)): path.read_bytes() for path in sorted(run_dir.rglob("*")) if path.is_file()}
 
@@ -102,6 +122,8 @@ def run_on_ray(
     threads: int = 1,
     gpus: float = 0.0,
     retries: int = 3,
+    checkpoint_freq: int | None = None,
+    checkpoint_dir: Path | None = None,
 ) -> dict[str, list[str]]:
     """Train ``pending`` as Ray tasks on the cluster at ``address`` and write each into ``out`` as it returns.
 
@@ -119,7 +141,10 @@ def run_on_ray(
     try:
         board = _progress_board(progress_board_name(out))
         task = ray.remote(train_remotely).options(num_cpus=threads, num_gpus=gpus, max_retries=retries, retry_exceptions=False)
-        in_flight = {task.remote(spec, eval_freq, eval_episodes, threads, board): spec for spec in pending}
+        in_flight = {
+            task.remote(spec, eval_freq, eval_episodes, threads, board, checkpoint_freq, checkpoint_dir): spec
+            for spec in pending
+        }
         print(f"submitted {len(in_flight)} runs to the Ray cluster at {address}", flush=True)
         last_report = time.monotonic()
         while in_flight:

@@ -132,7 +132,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         for spec in specs:
             print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
         return 0
-    checkpointing = (args.checkpoint_freq or None, args.checkpoint_dir)
+    checkpointing = (args.checkpoint_freq or None, args.checkpoint_dir.resolve() if args.checkpoint_dir else None)
     jobs = max(1, min(args.jobs, len(pending) or 1))
     threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)
     if pending and args.ray_address:
@@ -150,6 +150,8 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
             threads=args.threads or 1,
             gpus=args.ray_gpus,
             retries=args.ray_retries,
+            checkpoint_freq=checkpointing[0],
+            checkpoint_dir=checkpointing[1],
         )
     elif pending:
         out.mkdir(parents=True, exist_ok=True)

@@ -126,6 +126,7 @@ def run(
     else:
         state = read_state(checkpoint)
         resumed_from = [*state.get("resumed_from", []), int(checkpoint.name[5:])]
+        run_dir.mkdir(parents=True, exist_ok=True)  # a Ray retry resumes into a fresh folder
         shutil.copyfile(checkpoint / "curve.csv", run_dir / "curve.csv")  # rows after the checkpoint come again
         shutil.rmtree(run_dir / "zoo", ignore_errors=True)
     import torch as th

@@ -178,6 +178,9 @@ def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: st
 def _train() -> None:
     from rl_zoo3.train import train as zoo_train
 
+    from sb3_gqn.zoo import resume
+
+    resume.install()  # -i <checkpoint> continues with that checkpoint's replay buffer
     sys.argv = [sys.argv[0], *default_train_arguments(sys.argv[1:])]
     zoo_train()
 
