@@ -4,8 +4,10 @@
   meaning ``low + (high - low) * k / (bins - 1)``.
 * :class:`ActionPenalty`: reward ``r - coef * sum(a_norm ** 2)`` with ``a_norm`` the action rescaled
   to ``[-1, 1]`` (the paper's ``c_a * sum_j (a^j)^2`` on DeepMind Control's ``[-1, 1]`` actions).
+* :class:`ActionRatePenalty`: reward ``r - coef * sum(d ** 2)`` with ``d`` the change of ``a_norm`` since the previous
+  step, and the previous ``a_norm`` in the observation.
 
-Both take keyword arguments only after ``env`` so rl-zoo3's ``env_wrapper`` can build them, e.g.
+All take keyword arguments only after ``env`` so rl-zoo3's ``env_wrapper`` can build them, e.g.
 ``env_wrapper: [{sb3_gqn.common.wrappers.ActionPenalty: {coef: 0.1}}]``. Apply ``ActionPenalty`` to the
 continuous env, before (inside) ``DiscretizeAction``.
 """
@@ -116,6 +118,81 @@ class ActionPenalty(gym.Wrapper):
         obs, reward, terminated, truncated, info = self.env.step(action)
         penalty = self.penalty(action)
         info = dict(info)
-        info["task_reward"] = float(reward)
+        info.setdefault("task_reward", float(reward))  # an inner penalty wrapper already recorded the task's reward
         info["action_penalty"] = penalty
         return obs, float(reward) - penalty, terminated, truncated, info
+
+
+class ActionRatePenalty(gym.Wrapper):
+    """Penalize the change of the action between consecutive steps: reward ``r - coef * sum(d ** 2)``.
+
+    ``d = a_norm - a_norm_previous``, with ``a_norm`` the action rescaled to ``[-1, 1]`` as :class:`ActionPenalty`
+    rescales it; after ``reset`` the previous action is the middle of the range (``a_norm = 0``). The previous
+    ``a_norm`` is appended to the observation, so the penalized reward stays a function of observation and action
+    (Markov): a 1-D ``Box`` observation gets it appended (``obs_dim + action_dim`` values), a ``Dict`` observation
+    gets a ``"previous_action"`` key. ``info["action_rate_penalty"]`` holds the subtracted amount and
+    ``info["task_reward"]`` the reward before any penalty.
+
+    This is the action-rate term of legged-locomotion training: it makes a chattering policy pay for every switch
+    between bins, where :class:`ActionPenalty` makes it pay only for large actions.
+
+    :param env: env with a finite ``Box`` action space and a 1-D ``Box`` or a ``Dict`` observation space
+    :param coef: penalty coefficient (0 keeps the reward and only adds the previous action to the observation)
+    """
+
+    #: the key a ``Dict`` observation gets
+    PREVIOUS_ACTION_KEY = "previous_action"
+
+    def __init__(self, env: gym.Env, coef: float = 0.1):
+        super().__init__(env)
+        box = check_finite_box(env.action_space, "ActionRatePenalty (apply it before DiscretizeAction)")
+        if not np.isfinite(coef) or coef < 0:
+            raise ValueError(f"The action rate penalty coefficient must be finite and >= 0, got {coef}")
+        self.coef = float(coef)
+        self._low = box.low.astype(np.float64).reshape(-1)
+        self._high = box.high.astype(np.float64).reshape(-1)
+        previous = spaces.Box(-1.0, 1.0, (self._low.size,), dtype=np.float32)
+        observation_space = env.observation_space
+        if isinstance(observation_space, spaces.Dict):
+            if self.PREVIOUS_ACTION_KEY in observation_space.spaces:
+                raise ValueError(f"The observation space already has a {self.PREVIOUS_ACTION_KEY!r} key")
+            self.observation_space = spaces.Dict({**observation_space.spaces, self.PREVIOUS_ACTION_KEY: previous})
+        elif isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 1:
+            dtype = observation_space.dtype if np.issubdtype(observation_space.dtype, np.floating) else np.float32
+            self.observation_space = spaces.Box(
+                np.concatenate([observation_space.low, previous.low]).astype(dtype),
+                np.concatenate([observation_space.high, previous.high]).astype(dtype),
+                dtype=dtype,
+            )
+        else:
+            raise ValueError(
+                f"ActionRatePenalty appends the previous action to a 1-D Box or a Dict observation, got "
+                f"{observation_space}: flatten it first (gymnasium.wrappers.FlattenObservation)"
+            )
+        self.previous_action = np.zeros(self._low.size)
+
+    def normalize(self, action: Any) -> np.ndarray:
+        """The action rescaled to ``[-1, 1]`` per dimension (flattened)."""
+        action = np.asarray(action, dtype=np.float64).reshape(-1)
+        return 2.0 * (action - self._low) / (self._high - self._low) - 1.0
+
+    def _observation(self, observation: Any) -> Any:
+        previous = self.previous_action.astype(np.float32)
+        if isinstance(self.observation_space, spaces.Dict):
+            return {**observation, self.PREVIOUS_ACTION_KEY: previous}
+        return np.concatenate([np.asarray(observation).reshape(-1), previous]).astype(self.observation_space.dtype)
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        observation, info = self.env.reset(**kwargs)
+        self.previous_action = np.zeros(self._low.size)  # the middle of the range
+        return self._observation(observation), info
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        normalized = np.clip(self.normalize(action), -1.0, 1.0)
+        penalty = self.coef * float(np.sum((normalized - self.previous_action) ** 2))
+        self.previous_action = normalized
+        info = dict(info)
+        info.setdefault("task_reward", float(reward))
+        info["action_rate_penalty"] = penalty
+        return self._observation(observation), float(reward) - penalty, terminated, truncated, info

@@ -28,8 +28,8 @@ from sb3_gqn.experiments.checkpoints import (
     read_state,
     restore_random_state,
 )
-from sb3_gqn.experiments.variants import RunSpec, make_eval_env, penalized_wrappers, run_overrides
-from sb3_gqn.zoo.hyperparams import shipped_entry, shipped_hyperparams
+from sb3_gqn.experiments.variants import RunSpec, make_eval_env, run_overrides, run_wrappers
+from sb3_gqn.zoo.hyperparams import shipped_hyperparams
 
 #: Columns of results.csv, in order
 COLUMNS = [
@@ -138,7 +138,7 @@ def run(
     th.set_num_threads(threads)
     register()
     zoo_algo, overrides = run_overrides(spec)
-    wrappers = penalized_wrappers(shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
+    wrappers = run_wrappers(spec)
     if checkpoint_freq:
         wrappers = [*wrappers, "sb3_gqn.experiments.checkpoints.ReplayableResets"]
     manager = ExperimentManager(
@@ -172,7 +172,8 @@ def run(
         on_progress=on_progress,
     )
     callbacks: list[Any] = [*manager.callbacks, curve]
-    if spec.env == "Pendulum-v1" and hasattr(model, "growth_level"):
+    # figure 2 snapshots Q over Pendulum's own (cos, sin, velocity) observations only
+    if spec.env == "Pendulum-v1" and hasattr(model, "growth_level") and model.observation_space.shape == (3,):
         callbacks.append(save_q_snapshot(run_dir))
     if checkpoint_freq:
 

@@ -12,6 +12,8 @@ over that algorithm's shipped entry::
       add_policy_kwargs: n_critics=2   # optional: keyword arguments added to the entry's policy_kwargs
       env_hyperparams:                 # optional: per env, set over the entry before ``hyperparams``
         dm_control/walker-walk-v0: {train_freq: 2}
+      add_env_wrappers:                # optional: wrappers around the entry's (rl-zoo3's env_wrapper format), in
+        - sb3_gqn.wrappers.ActionRatePenalty: {coef: 0.1}   # training and evaluation
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ class Variant:
     hyperparams: dict[str, Any] = field(default_factory=dict, hash=False)
     add_policy_kwargs: str | None = None
     env_hyperparams: dict[str, dict[str, Any]] = field(default_factory=dict, hash=False)
+    add_env_wrappers: list[Any] = field(default_factory=list, hash=False)
 
     def overrides(self, env_id: str) -> dict[str, Any]:
         """The hyperparameters this agent sets over its entry for ``env_id``."""
@@ -63,17 +66,18 @@ def load_variants(path: str | Path) -> dict[str, Variant]:
     """
     loaded = {}
     for name, entry in read_entries(path).items():
-        unknown = set(entry) - {"algo", "hyperparams", "add_policy_kwargs", "env_hyperparams"}
+        unknown = set(entry) - {"algo", "hyperparams", "add_policy_kwargs", "env_hyperparams", "add_env_wrappers"}
         if entry.get("algo") not in ZOO_ALGOS or unknown:
             raise ValueError(
                 f"{path}: variant {name!r} needs 'algo' (one of {ZOO_ALGOS}) and only the keys hyperparams, "
-                f"add_policy_kwargs, env_hyperparams; got {sorted(entry)}"
+                f"add_policy_kwargs, env_hyperparams, add_env_wrappers; got {sorted(entry)}"
             )
         variant = Variant(
             entry["algo"],
             dict(entry.get("hyperparams") or {}),
             entry.get("add_policy_kwargs"),
             {env: dict(values or {}) for env, values in (entry.get("env_hyperparams") or {}).items()},
+            list(entry.get("add_env_wrappers") or []),
         )
         if name in VARIANTS and VARIANTS[name] != variant:
             raise ValueError(f"{path}: variant {name!r} redefines an agent the runner already has")
@@ -145,6 +149,14 @@ def penalized_wrappers(env_wrapper: Any, penalty: float) -> list[Any]:
     return [*kept, {name: {"coef": float(penalty)}}]
 
 
+def run_wrappers(spec: RunSpec) -> list[Any]:
+    """The run's ``env_wrapper`` list: its entry's, with the ``ActionPenalty`` coefficient set to ``spec.penalty``, then
+    the wrappers its agent adds (``add_env_wrappers``), for training and evaluation alike."""
+    assert spec.variant is not None  # set by RunSpec.__post_init__
+    wrappers = penalized_wrappers(shipped_entry(spec.variant.algo, spec.env).get("env_wrapper"), spec.penalty)
+    return [*wrappers, *spec.variant.add_env_wrappers]
+
+
 def run_overrides(spec: RunSpec) -> tuple[str, dict[str, Any]]:
     """The run's rl-zoo3 algorithm and the hyperparameters its agent sets over the shipped entry."""
     assert spec.variant is not None  # set by RunSpec.__post_init__
@@ -196,8 +208,6 @@ def make_eval_env(spec: RunSpec) -> gym.Env:
     set to ``spec.penalty``. Call :func:`sb3_gqn.zoo.register` first for the dm_control and Meta-World ids."""
     from rl_zoo3.utils import get_wrapper_class
 
-    zoo_algo, _ = run_overrides(spec)
-    wrappers = penalized_wrappers(shipped_entry(zoo_algo, spec.env).get("env_wrapper"), spec.penalty)
-    wrapper = get_wrapper_class({"env_wrapper": wrappers})
+    wrapper = get_wrapper_class({"env_wrapper": run_wrappers(spec)})
     env = gym.make(spec.env)
     return wrapper(env) if wrapper is not None else env
