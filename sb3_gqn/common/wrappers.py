@@ -88,6 +88,14 @@ class DiscretizeAction(gym.ActionWrapper):
         return self.grid.to_continuous(np.asarray(action).reshape(self.grid.action_dims))
 
 
+def penalty_bounds(env: gym.Env, coef: float, wrapper: str, what: str) -> tuple[float, np.ndarray, np.ndarray]:
+    """A penalty wrapper's checked coefficient and its env's action bounds (flattened, float64)."""
+    box = check_finite_box(env.action_space, f"{wrapper} (apply it before DiscretizeAction)")
+    if not np.isfinite(coef) or coef < 0:
+        raise ValueError(f"The {what} coefficient must be finite and >= 0, got {coef}")
+    return float(coef), box.low.astype(np.float64).reshape(-1), box.high.astype(np.float64).reshape(-1)
+
+
 class ActionPenalty(gym.Wrapper):
     """Penalize action magnitude: reward ``r - coef * sum(a_norm ** 2)``.
 
@@ -102,12 +110,8 @@ class ActionPenalty(gym.Wrapper):
 
     def __init__(self, env: gym.Env, coef: float = 0.1):
         super().__init__(env)
-        box = check_finite_box(env.action_space, "ActionPenalty (apply it before DiscretizeAction)")
-        if not np.isfinite(coef) or coef < 0:
-            raise ValueError(f"The action penalty coefficient must be finite and >= 0, got {coef}")
-        self.coef = float(coef)
-        self._low = box.low.astype(np.float64)
-        self._high = box.high.astype(np.float64)
+        self.coef, self._low, self._high = penalty_bounds(env, coef, "ActionPenalty", "action penalty")
+        self._low, self._high = self._low.reshape(env.action_space.shape), self._high.reshape(env.action_space.shape)
 
     def penalty(self, action: np.ndarray) -> float:
         """``coef * sum(a_norm ** 2)`` for one action."""
@@ -145,12 +149,7 @@ class ActionRatePenalty(gym.Wrapper):
 
     def __init__(self, env: gym.Env, coef: float = 0.1):
         super().__init__(env)
-        box = check_finite_box(env.action_space, "ActionRatePenalty (apply it before DiscretizeAction)")
-        if not np.isfinite(coef) or coef < 0:
-            raise ValueError(f"The action rate penalty coefficient must be finite and >= 0, got {coef}")
-        self.coef = float(coef)
-        self._low = box.low.astype(np.float64).reshape(-1)
-        self._high = box.high.astype(np.float64).reshape(-1)
+        self.coef, self._low, self._high = penalty_bounds(env, coef, "ActionRatePenalty", "action rate penalty")
         previous = spaces.Box(-1.0, 1.0, (self._low.size,), dtype=np.float32)
         observation_space = env.observation_space
         if isinstance(observation_space, spaces.Dict):
