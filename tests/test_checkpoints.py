@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch as th
 
@@ -134,3 +135,27 @@ def test_rl_zoo_continues_from_a_checkpoint_with_its_replay_buffer_and_growth(tm
     # rl-zoo3 restarts num_timesteps; growth goes on from step 600 of the model's life (600 + 600 * 3 / 5)
     assert (continued.num_timesteps, continued.growth_step) == (600, 1_200)
     assert continued.growth_events == [(240, 3), (480, 5), (960, 9)]
+
+
+@pytest.mark.parametrize("legacy", [False, True])
+def test_replayable_resets_repeat_the_last_reset_for_both_kinds_of_generator(legacy):
+    """Gymnasium's ``Generator`` and the legacy ``RandomState`` (shimmy's dm_control envs) both replay."""
+    from sb3_gqn.experiments.checkpoints import ReplayableResets
+
+    class RandomStart(DecliningEnv):
+        def reset(self, *, seed=None, options=None):
+            super().reset(seed=seed)
+            if legacy and seed is not None:
+                self._np_random = np.random.RandomState(seed)
+            start = self.np_random.uniform(-1, 1, size=3) if not legacy else self.np_random.uniform(-1, 1, 3)
+            return start.astype(np.float32), {}
+
+    env = ReplayableResets(RandomStart())
+    env.reset(seed=3)
+    first, _ = env.reset()
+    state = env.state_before_reset
+    second, _ = env.reset()
+    assert not np.array_equal(first, second)
+    env.replay_next_reset(state)
+    np.testing.assert_array_equal(env.reset()[0], first)
+    assert isinstance(env.unwrapped.np_random, np.random.RandomState) == legacy

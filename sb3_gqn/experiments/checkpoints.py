@@ -52,11 +52,15 @@ class ReplayableResets(gym.Wrapper):
         self._replay: dict[str, Any] | None = None
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
-        generator = self.env.unwrapped.np_random
+        generator = self.env.unwrapped.np_random  # a Generator, or a legacy RandomState (shimmy's dm_control envs)
         if self._replay is not None and kwargs.get("seed") is None:
-            generator.bit_generator.state = self._replay
+            if hasattr(generator, "bit_generator"):
+                generator.bit_generator.state = self._replay
+            else:
+                generator.set_state(self._replay)
             self._replay = None
-        self.state_before_reset = generator.bit_generator.state
+        legacy = not hasattr(generator, "bit_generator")
+        self.state_before_reset = generator.get_state() if legacy else generator.bit_generator.state
         return self.env.reset(**kwargs)
 
     def replay_next_reset(self, state: dict[str, Any] | None) -> None:
