@@ -14,7 +14,14 @@ import pytest
 import torch as th
 
 from sb3_gqn import GQN
-from sb3_gqn.experiments.checkpoints import KEEP, RunCheckpointCallback, checkpoint_steps, newest_whole_checkpoint
+from sb3_gqn.experiments.checkpoints import (
+    KEEP,
+    RunCheckpointCallback,
+    checkpoint_steps,
+    is_whole,
+    newest_whole_checkpoint,
+    write_checkpoint,
+)
 from sb3_gqn.experiments.runs import run
 from sb3_gqn.experiments.variants import RunSpec
 from tests.envs import DecliningEnv
@@ -96,6 +103,24 @@ def test_a_torn_newest_checkpoint_falls_back_to_the_one_before(tmp_path):
     (tmp_path / f"step_{before}" / "complete").unlink()  # a write that never finished
     with pytest.warns(UserWarning, match="damaged"):
         assert newest_whole_checkpoint(tmp_path) is None
+
+
+def test_a_truncated_replay_buffer_is_found_by_its_size_and_old_checkpoints_still_count(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8]), learning_starts=10, train_freq=1)
+    model.learn(20)
+    checkpoint = write_checkpoint(tmp_path, model, None, {})
+    record = json.loads((checkpoint / "complete").read_text())
+    buffer = checkpoint / "replay_buffer.pkl"
+    assert record["step"] == 20 and record["sizes"]["replay_buffer.pkl"] == buffer.stat().st_size > 0
+    assert is_whole(checkpoint)
+    whole = buffer.read_bytes()
+    buffer.write_bytes(whole[:-1])  # one byte short: the write was cut
+    assert not is_whole(checkpoint)
+    # a checkpoint from before the sizes were recorded: its buffer is unpickled instead
+    (checkpoint / "complete").write_text("20")
+    assert not is_whole(checkpoint)
+    buffer.write_bytes(whole)
+    assert is_whole(checkpoint)
 
 
 def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):

@@ -8,10 +8,12 @@ A checkpoint is a folder ``step_<N>/`` under the run's checkpoint folder:
 - ``curve.csv``: the learning curve up to step N;
 - ``state.pkl``: the random number generators (Python, NumPy, PyTorch, the training envs' reset generators) and the
   training seconds so far;
-- ``complete``: written last.
+- ``complete``: written last, with the size of every other file.
 
 It is written as ``step_<N>.tmp/`` and renamed, so a folder named ``step_<N>`` is whole unless the disk lied; a torn
-one (no ``complete``, or a file that does not load) is skipped for the one before it. The last :data:`KEEP` are kept.
+one (no ``complete``, a file of another size than recorded, a model zip that fails its CRC check, a ``state.pkl`` that
+does not load) is skipped for the one before it. The replay buffer is checked by size only: it is read once, by the
+resume itself. The last :data:`KEEP` are kept.
 
 SB3's ``CheckpointCallback`` saves from ``on_step``, which SB3 calls before it stores the step's transition; a resumed
 run would miss that transition and cut the episode in progress. :class:`RunCheckpointCallback` saves at the start of a
@@ -21,6 +23,7 @@ steps, and :class:`ReplayableResets` lets the resumed run's first reset repeat t
 
 from __future__ import annotations
 
+import json
 import os
 import pickle
 import random
@@ -68,10 +71,16 @@ class ReplayableResets(gym.Wrapper):
         self._replay = state
 
 
+def _innermost(vec_env: VecEnv) -> VecEnv:
+    """The VecEnv under every VecEnv wrapper (VecNormalize, VecMonitor, ...)."""
+    while hasattr(vec_env, "venv"):
+        vec_env = vec_env.venv
+    return vec_env
+
+
 def _reset_wrappers(vec_env: VecEnv) -> list[ReplayableResets | None]:
     """The :class:`ReplayableResets` of each env of a ``DummyVecEnv`` (``None`` where there is none, or for other VecEnvs)."""
-    while hasattr(vec_env, "venv"):  # VecNormalize, VecMonitor, ... wrap the DummyVecEnv
-        vec_env = vec_env.venv
+    vec_env = _innermost(vec_env)
     if not isinstance(vec_env, DummyVecEnv):
         return []
     found: list[ReplayableResets | None] = []
@@ -96,9 +105,7 @@ def random_state(model: Any) -> dict[str, Any]:
 
 def restore_random_state(model: Any, state: dict[str, Any]) -> None:
     """Undo :func:`random_state`: the next reset of each training env repeats the interrupted run's last one."""
-    vec_env = model.env
-    while hasattr(vec_env, "venv"):
-        vec_env = vec_env.venv
+    vec_env = _innermost(model.env)
     if hasattr(vec_env, "_reset_seeds"):  # load() seeded the next reset; the replayed one must not be
         vec_env._reset_seeds()
     random.setstate(state["python"])
@@ -134,10 +141,12 @@ def write_checkpoint(folder: Path, model: Any, curve: Path | None, extra: dict[s
         shutil.copyfile(curve, scratch / "curve.csv")
     with open(scratch / "state.pkl", "wb") as handle:
         pickle.dump({"random": random_state(model), **extra}, handle)
+    sizes: dict[str, int] = {}
     for path in scratch.iterdir():  # on disk before the rename makes the folder count
         with open(path, "rb") as handle:
             os.fsync(handle.fileno())
-    (scratch / COMPLETE).write_text(str(step))
+        sizes[path.name] = path.stat().st_size
+    (scratch / COMPLETE).write_text(json.dumps({"step": step, "sizes": sizes}))
     shutil.rmtree(final, ignore_errors=True)
     os.replace(scratch, final)
     for old in checkpoint_steps(folder)[KEEP:]:
@@ -146,17 +155,22 @@ def write_checkpoint(folder: Path, model: Any, curve: Path | None, extra: dict[s
 
 
 def is_whole(checkpoint: Path) -> bool:
-    """Whether a checkpoint folder was written to the end and its files read back (the model zip opens, the pickles
-    unpickle)."""
+    """Whether a checkpoint folder was written to the end: every file has the size ``complete`` recorded, the model
+    zip passes its CRC check and ``state.pkl`` unpickles. (A ``complete`` without sizes, from an earlier release, has
+    ``replay_buffer.pkl`` unpickled instead.)"""
     import zipfile
 
     try:
         if not (checkpoint / COMPLETE).is_file():
             return False
+        record = (checkpoint / COMPLETE).read_text()
+        sizes: dict[str, int] = json.loads(record)["sizes"] if record.lstrip().startswith("{") else {}
+        if any((checkpoint / name).stat().st_size != size for name, size in sizes.items()):
+            return False
         with zipfile.ZipFile(checkpoint / "model.zip") as archive:
             if archive.testzip() is not None:
                 return False
-        for name in ("state.pkl", "replay_buffer.pkl"):
+        for name in ("state.pkl",) if sizes else ("state.pkl", "replay_buffer.pkl"):
             if (checkpoint / name).exists():
                 with open(checkpoint / name, "rb") as handle:
                     pickle.load(handle)
