@@ -113,7 +113,7 @@ def test_loading_another_algorithms_file_names_it(tmp_path):
         with pytest.raises(ValueError, match=message):
             cls.load(tmp_path / "sac")
     GQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "gqn")
-    with pytest.raises(ValueError, match=r"holds a GQN model \(bins \[2, 9\], growth 'adaptive'\), not a DecQN model"):
+    with pytest.raises(ValueError, match=r"holds a GQN model \(bins \[3, 9\], growth 'adaptive'\), not a DecQN model"):
         DecQN.load(tmp_path / "gqn")
     DecQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "decqn")
     assert GQN.load(tmp_path / "decqn").bin_levels == [9]  # DecQN is GQN with static bins: GQN loads it
@@ -135,7 +135,7 @@ def test_loading_the_other_kind_of_replay_buffer_is_an_error_and_keeps_the_buffe
 
 
 def test_linear_growth_keeps_one_step_counter_when_learn_resets_num_timesteps(tmp_path):
-    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", train_freq=1, **TINY)
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth="linear", train_freq=1, **TINY)
     # 4 levels over 400 steps: level g opens after g / 5 of the budget (80, 160, 240); a checkpoint at step 200
     model.learn(400, callback=CheckpointCallback(save_freq=200, save_path=str(tmp_path)))
     assert model.growth_events == [(80, 3), (160, 5), (240, 9)]
@@ -149,7 +149,7 @@ def test_linear_growth_keeps_one_step_counter_when_learn_resets_num_timesteps(tm
 
 def test_adaptive_growth_keeps_one_step_counter_when_learn_resets_num_timesteps(tmp_path):
     kwargs = dict(growth="adaptive", growth_eval_freq=20, growth_window=2, growth_patience=1, train_freq=1)
-    model = GQN("MlpPolicy", DecliningEnv(), **kwargs, **TINY)
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), **kwargs, **TINY)
     model.learn(100)
     model.save(tmp_path / "model")
     first = list(model.growth_events)
@@ -207,7 +207,7 @@ def test_the_cli_explains_unquoted_string_values(capsys, tmp_path):
 
 @pytest.mark.parametrize(
     "env_id, bins, penalty",
-    [("MountainCarContinuous-v0", [2, 9], True), ("Acrobot-v1", [2, 3], False), ("CartPole-v1", 2, False)],
+    [("MountainCarContinuous-v0", [3, 9], True), ("Acrobot-v1", [2, 3], False), ("CartPole-v1", 2, False)],
 )
 def test_every_no_entry_template_trains_its_env(capsys, tmp_path, env_id, bins, penalty):
     argv = ["--algo", "gqn", "--env", env_id, "-f", str(tmp_path), "-n", "10"]

@@ -32,6 +32,7 @@ RESEARCH_VARIANTS = Path(__file__).resolve().parents[1] / "docs" / "research" / 
 load_variants(RESEARCH_VARIANTS)  # the research record's agents, which the committed tables hold
 REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
 RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
+PLAIN_TORSO = "dict(layer_norm=False, activation_fn=nn.ReLU)"
 #: the paper as written, the research ablation's starting point
 BEFORE_GROWTH_FIXES = {
     "growth": "adaptive",
@@ -227,16 +228,16 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_v
         for env in (walker, finger):
             assert trained(algo, env)["train_freq"] == 1
         # cartpole (the main job) keeps the plain MLP and 1 update per 2 env steps
-        assert trained(algo, cartpole)["train_freq"] == 2 and "policy_kwargs" not in trained(algo, cartpole)
+        assert trained(algo, cartpole)["train_freq"] == 2 and trained(algo, cartpole)["policy_kwargs"] == PLAIN_TORSO
     # The torso-alone probes and the ablation keep what they were recorded with (1 update per 2 steps; the MLP torso)
     for algo in ("gqn-adaptive+layernorm", "decqn-9+layernorm"):
         assert trained(algo, walker)["train_freq"] == 2 and trained(algo, walker)["policy_kwargs"] == REFERENCE_TORSO
     for env in (walker, finger):
         before = trained("gqn-before+shared", env)
-        assert before["train_freq"] == 2 and before["policy_kwargs"] is None and before["exploration"] == "shared"
+        assert before["train_freq"] == 2 and before["policy_kwargs"] == PLAIN_TORSO and before["exploration"] == "shared"
         assert run_overrides(RunSpec("gqn-before", env, 0.1, 0, 1000))[1] == {
             "train_freq": 2,
-            "policy_kwargs": None,
+            "policy_kwargs": PLAIN_TORSO,
             **BEFORE_GROWTH_FIXES,
         }
 
@@ -332,8 +333,10 @@ def test_two_critics_keep_the_entry_torso():
         "dict(residual_layer_norm=True, n_critics=2)"
     )
     assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["train_freq"] == 1
-    # cartpole's entry has no policy_kwargs: its recorded twin runs trained exactly this
-    assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0")["policy_kwargs"] == "dict(n_critics=2)"
+    # cartpole's entry pins the plain MLP its recorded twin runs trained
+    assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0")["policy_kwargs"] == (
+        "dict(layer_norm=False, activation_fn=nn.ReLU, n_critics=2)"
+    )
     # decqn-9's twin keeps decqn.yml's entry (finger's DecQN default torso) at 9 bins
     finger_decqn = trained("decqn-9+twin", "dm_control/finger-spin-v0")
     assert finger_decqn["policy_kwargs"] == "dict(layer_norm=True, activation_fn=nn.ELU, n_critics=2)"

@@ -106,7 +106,7 @@ def test_decqn_rejects_growth_and_pairs():
 
 
 def test_grow_backwards_or_past_the_end():
-    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8]))
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), policy_kwargs=dict(net_arch=[8]))
     model.grow(3)
     with pytest.raises(ValueError, match="Cannot grow"):
         model.grow(1)

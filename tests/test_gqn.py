@@ -26,7 +26,15 @@ def test_box_env_is_discretized_to_the_finest_level():
 
 def test_stored_actions_never_leave_the_active_set_before_and_after_growth():
     total = 2_000
-    model = GQN("MlpPolicy", "Pendulum-v1", growth="linear", exploration_initial_eps=0.5, exploration_final_eps=0.5, **SMALL)
+    model = GQN(
+        "MlpPolicy",
+        "Pendulum-v1",
+        bins=(2, 9),
+        growth="linear",
+        exploration_initial_eps=0.5,
+        exploration_final_eps=0.5,
+        **SMALL,
+    )
     model.learn(total)
     assert model.active_bins == 9
     stored = model.replay_buffer.actions[:total, 0, 0]
@@ -56,7 +64,7 @@ def test_predict_stays_in_active_set():
 
 
 def test_linear_growth_steps_in_a_run():
-    model = GQN("MlpPolicy", DecliningEnv(), growth="linear", **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth="linear", **SMALL)
     seen = {}
 
     def record(locals_, globals_):
@@ -91,12 +99,14 @@ def test_adaptive_evaluation_episodes_are_greedy():
     model = GQN(
         "MlpPolicy",
         DecliningEnv(length=5, action_dims=4),
+        bins=(2, 9),
         growth="adaptive",
         growth_eval_freq=50,
         growth_window=1000,  # never decides: we only look at the actions
         growth_patience=None,
         exploration_initial_eps=1.0,
         exploration_final_eps=1.0,
+        train_freq=8,  # rollouts of 8 steps: learn(500) ends at step 504
         gradient_steps=0,
         **{**SMALL, "learning_starts": 0},
     )
@@ -122,7 +132,14 @@ def test_adaptive_evaluation_episodes_are_greedy():
 def test_save_load_round_trip(tmp_path):
     # a window longer than the run: the schedule collects statistics but never decides
     model = GQN(
-        "MlpPolicy", DecliningEnv(), growth="adaptive", growth_eval_freq=10, growth_window=100, growth_patience=None, **SMALL
+        "MlpPolicy",
+        DecliningEnv(),
+        bins=(2, 9),
+        growth="adaptive",
+        growth_eval_freq=10,
+        growth_window=100,
+        growth_patience=None,
+        **SMALL,
     )
     model.learn(150)
     assert len(model.growth_schedule.history) >= 10
@@ -252,7 +269,7 @@ def test_sb3_evaluation_tools_work_on_the_box_env():
 
     from sb3_gqn.common.wrappers import ActionPenalty
 
-    model = GQN("MlpPolicy", DecliningEnv(), **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), **SMALL)
     rewards, _ = evaluate_policy(model, Monitor(ActionPenalty(DecliningEnv(), coef=0.1)), 2, return_episode_rewards=True)
     # episode 1 of a fresh env: reward -1/5 per step over 5 steps, penalty 0.1 * 2 (both dims at a bang-bang bin)
     assert rewards[0] == pytest.approx(-1.0 - 5 * 0.2)
@@ -369,17 +386,18 @@ def test_every_growth_and_exploration_option_learns(options):
 def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
     from tests.envs import FlatEnv
 
-    eq4_only = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=None, **SMALL).learn(400)
+    eq4_only = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_eval_freq=10, growth_patience=None, **SMALL).learn(400)
     assert eq4_only.active_bins == 2
-    with_plateau = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=2, **SMALL).learn(400)
+    with_plateau = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_eval_freq=10, growth_patience=2, **SMALL).learn(400)
     assert with_plateau.active_bins == 9
 
 
 @pytest.mark.parametrize(
     "torso",
     [
-        dict(layer_norm=True, activation_fn=th.nn.ELU),
-        dict(residual=True),
+        dict(),  # the default: LayerNorm + ELU
+        dict(layer_norm=False, activation_fn=th.nn.ReLU),  # the plain MLP of 0.2.0 (cartpole's shipped entry)
+        dict(layer_norm=False, residual=True),
         dict(layer_norm=True, residual=True),
         dict(residual_layer_norm=True),
     ],
@@ -392,7 +410,10 @@ def test_every_torso_option_learns_grows_and_round_trips(torso, tmp_path):
     model.learn(400)
     assert model.active_bins == 9 and model._n_updates > 0
     layers = [type(layer) for layer in model.q_net.modules()]
-    assert (th.nn.LayerNorm in layers) == bool(torso.get("layer_norm") or torso.get("residual_layer_norm"))
+    assert (th.nn.LayerNorm in layers) == bool(torso.get("layer_norm", True) or torso.get("residual_layer_norm"))
+    activations = {th.nn.ELU, th.nn.ReLU} & set(layers)
+    if not torso.get("residual_layer_norm"):
+        assert activations == {torso.get("activation_fn", th.nn.ELU)}
     observations = np.random.default_rng(0).normal(size=(64, 3)).astype(np.float32)
     expected, _ = model.predict(observations, deterministic=True)
     model.save(tmp_path / "gqn")
@@ -443,3 +464,31 @@ def test_two_critics_act_on_their_maximum_learn_both_grow_both_and_round_trip(tm
 def test_n_critics_must_be_a_positive_integer(n_critics):
     with pytest.raises(ValueError, match="n_critics must be a positive integer"):
         GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(n_critics=n_critics))
+
+
+def test_the_defaults_are_the_development_suites_choice():
+    """GQN's and DecQN's defaults: LayerNorm + ELU torso, 1 gradient step per env step, bins (3, 9) for GQN."""
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8, 8]))
+    assert model.bins == (3, 9) and model.bin_levels == [3, 5, 9] and model.active_bins == 3
+    assert (model.train_freq.frequency, model.train_freq.unit.value, model.gradient_steps) == (1, "step", 1)
+    # DecQN's torso: Linear -> LayerNorm -> tanh, then Linear -> ELU
+    layers = [type(layer) for layer in model.q_net.modules() if type(layer).__module__.startswith("torch.nn.modules")]
+    layers = [layer for layer in layers if layer not in (th.nn.ModuleList, th.nn.Sequential)]
+    layers = [layer for layer in layers if layer is not th.nn.Flatten]
+    assert layers[:5] == [th.nn.Linear, th.nn.LayerNorm, th.nn.Tanh, th.nn.Linear, th.nn.ELU]
+    decqn = DecQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8, 8]))
+    assert decqn.bin_levels == [9] and decqn.train_freq.frequency == 1
+    assert th.nn.LayerNorm in [type(layer) for layer in decqn.q_net.modules()]
+
+
+def test_policy_kwargs_choose_the_torso_and_are_not_changed():
+    from sb3_gqn.common.torsos import with_default_torso
+
+    chosen = dict(net_arch=[8], layer_norm=False)
+    assert with_default_torso(chosen) == dict(net_arch=[8], layer_norm=False, activation_fn=th.nn.ELU)
+    assert chosen == dict(net_arch=[8], layer_norm=False)  # the caller's dict is left alone
+    assert with_default_torso(None) == dict(layer_norm=True, activation_fn=th.nn.ELU)
+    assert with_default_torso(dict(residual_layer_norm=True)) == dict(residual_layer_norm=True)
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8], layer_norm=False, activation_fn=th.nn.ReLU))
+    layers = [type(layer) for layer in model.q_net.modules()]
+    assert th.nn.LayerNorm not in layers and th.nn.ELU not in layers and th.nn.ReLU in layers

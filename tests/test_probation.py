@@ -14,7 +14,9 @@ from sb3_gqn.experiments.report import growth_checks
 from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth, probation_holds
 from tests.envs import DecliningEnv, FlatEnv
 
-SMALL = dict(policy_kwargs=dict(net_arch=[32, 32]), learning_starts=100, buffer_size=10_000, batch_size=32, seed=0)
+SMALL = dict(
+    bins=(2, 9), policy_kwargs=dict(net_arch=[32, 32]), learning_starts=100, buffer_size=10_000, batch_size=32, seed=0
+)
 
 
 def test_probation_holds_at_70_percent_of_a_positive_reference_and_130_percent_of_a_negative_one():

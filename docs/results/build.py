@@ -3,7 +3,8 @@
 Reads the comparison suite's ``docs/results/<task>_c0.1_100k*/results.csv`` files, maps the runs of each task's shipped
 entry to the plain agent names (:func:`shipped`), and rewrites the blocks between ``<!-- BEGIN generated: NAME -->`` and
 ``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``, and
-``main-job`` from the committed reference runs in ``docs/results/reference_run/``), and the
+``main-job`` from the committed reference runs in ``docs/results/reference_run/``, ``development`` from the
+development suite's runs in ``docs/results/development/``), and the
 figures in ``docs/results/main/``. The prose around the blocks is written by hand. Run from the repository root after
 extending a table with the comparison runner.
 """
@@ -47,6 +48,16 @@ BASELINE_PAIRS = [("gqn-adaptive", "sac"), ("gqn-linear", "sac"), ("decqn-9", "s
 MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
 #: the IQM reads 8 runs per agent and task, each agent's lowest seeds (0-7); the "every run" columns pool them all
 IQM_RUNS = 8
+#: The development suite the class defaults were chosen on (docs/research/defaults.md): its agents, as the README names
+#: them. On its tasks, the first trains what GQN's defaults (and the entries without tuned settings) train now.
+DEVELOPMENT = RESULTS / "development" / "results.csv"
+DEVELOPMENT_AGENTS = {
+    "gqn-adaptive+layernorm+1update+bins3-9": "GQN (defaults)",
+    "decqn-9+layernorm+1update": "DecQN-9",
+    "decqn-2+layernorm+1update": "DecQN-2",
+    "sac": "SAC",
+    "gqn-adaptive-0.2": "GQN (0.2.0 defaults)",
+}
 
 
 def shipped(table: pd.DataFrame) -> pd.DataFrame:
@@ -143,6 +154,29 @@ def main_job_block(runs: Path = RESULTS / "reference_run") -> str:
     )
 
 
+def development_block(path: Path = DEVELOPMENT) -> str:
+    """The development suite's final returns: one row per task and penalty, one column per agent of
+    :data:`DEVELOPMENT_AGENTS`: mean over seeds [95 % bootstrap interval] (seeds), and Meta-World's success rate."""
+    final = final_rows(load([path]))
+    agents = [agent for agent in DEVELOPMENT_AGENTS if agent in set(final["algo"])]
+    lines = ["| task | c | " + " | ".join(DEVELOPMENT_AGENTS[agent] for agent in agents) + " |"]
+    lines.append("| --- | --- |" + " --- |" * len(agents))
+    for (env, penalty), runs in final.groupby(["env", "penalty"]):
+        cells = []
+        for agent in agents:
+            agent_runs = runs[runs["algo"] == agent]
+            if agent_runs.empty:
+                cells.append("-")
+                continue
+            mean, (low, high) = mean_interval(agent_runs["return"].to_numpy())
+            cell = f"{mean:.0f} [{low:.0f}, {high:.0f}] ({len(agent_runs)})" if len(agent_runs) > 1 else f"{mean:.0f} (1)"
+            success = agent_runs["success"].dropna() if "success" in agent_runs else agent_runs["return"].iloc[:0]
+            cells.append(cell + (f", success {success.mean():.2f}" if len(success) else ""))
+        task = str(env).split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
+        lines.append(f"| {task} | {penalty:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def replace_block(path: Path, name: str, body: str) -> None:
     """Rewrite the generated block ``name`` of the Markdown file ``path``."""
     text = path.read_text()
@@ -160,7 +194,8 @@ def run() -> int:
     replace_block(PAGE, "main", main_block(table))
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
-    print(f"rebuilt {PAGE} (main), {README} (results, main-job) and the figures in {RESULTS / 'main'}")
+    replace_block(README, "development", development_block())
+    print(f"rebuilt {PAGE} (main), {README} (results, main-job, development) and the figures in {RESULTS / 'main'}")
     return 0
 
 

@@ -3,9 +3,24 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import torch as th
 from torch import nn
+
+#: The torso GQN and DecQN build unless ``policy_kwargs`` choose another: LayerNorm in each hidden block and ELU
+#: (DecQN's default torso). ``GQNPolicy``'s own defaults stay the plain ReLU MLP that models saved by 0.2.0 and
+#: earlier were built with, so those load as saved.
+DEFAULT_TORSO: dict[str, Any] = {"layer_norm": True, "activation_fn": nn.ELU}
+
+
+def with_default_torso(policy_kwargs: dict[str, Any] | None) -> dict[str, Any]:
+    """A copy of ``policy_kwargs`` with :data:`DEFAULT_TORSO`'s entries where they do not choose their own; unchanged
+    when they choose the residual torso (``residual_layer_norm=True``), which brings its own."""
+    chosen = dict(policy_kwargs or {})
+    if chosen.get("residual_layer_norm"):
+        return chosen
+    return {**DEFAULT_TORSO, **chosen}
 
 
 def variance_scaling_uniform_(linear: nn.Linear, scale: float = 1.0 / 3.0) -> nn.Linear:

@@ -23,6 +23,7 @@ from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
 from sb3_gqn.common.masking import EXPLORATION_MODES, active_bin_indices, epsilon_greedy
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
+from sb3_gqn.common.torsos import with_default_torso
 from sb3_gqn.common.wrappers import BinGrid
 from sb3_gqn.gqn.growth.callback import GrowthCallback
 from sb3_gqn.gqn.growth.resolution import GrowingResolution
@@ -60,7 +61,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     :param tau: the soft update coefficient ("Polyak update", between 0 and 1), default 1 for a hard update
     :param gamma: the discount factor
     :param train_freq: Update the model every ``train_freq`` steps (or a ``(frequency, "step" | "episode")`` tuple);
-        with ``gradient_steps=1`` the default 8 is DecQN's 32 samples per insert at batch 256
+        the default 1 (with ``gradient_steps=1``) is 1 gradient step per env step; DecQN's public configuration uses 8
     :param gradient_steps: How many gradient steps to do after each rollout (``-1``: as many as env steps)
     :param replay_buffer_class: Replay buffer class to use; ``None`` chooses
         (:func:`~sb3_gqn.common.buffers.default_replay_buffer_class`): the prioritized n-step buffer, or SB3's n-step
@@ -90,8 +91,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     :param importance_sampling_annealing: anneal beta linearly to 1 over ``total_timesteps`` (Schaul et al.)
         instead of keeping it constant (DecQN)
     :param bins: bins per action dimension: an ``(initial, final)`` pair grows through the nested levels
-        (``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and MultiDiscrete envs must have ``final``
-        choices per dimension.
+        (``(3, 9)``: 3, 5, 9; the paper's ``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and
+        MultiDiscrete envs must have ``final`` choices per dimension.
     :param growth: ``"adaptive"`` (eq. 4 plus the plateau rule), ``"linear"`` (with ``N`` levels, e.g. ``N = 4`` for
         ``(2, 9)``, level ``g`` opens after ``g / (N + 1)`` of ``total_timesteps``) or ``None`` (stay at the first level)
     :param growth_init: ``"interpolate"``: a newly opened bin's head row starts as the mean of its two nested
@@ -114,7 +115,10 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
     :param policy_kwargs: additional arguments to be passed to the policy on creation (``net_arch``, ``layer_norm``,
-        ``residual``, ``residual_layer_norm``, ``n_critics``, ...; see :class:`~sb3_gqn.gqn.policies.GQNPolicy`)
+        ``residual``, ``residual_layer_norm``, ``n_critics``, ...; see :class:`~sb3_gqn.gqn.policies.GQNPolicy`). The
+        torso is DecQN's LayerNorm + ELU MLP (:data:`~sb3_gqn.common.torsos.DEFAULT_TORSO`) unless they choose
+        ``layer_norm``, ``activation_fn`` or ``residual_layer_norm``: ``dict(layer_norm=False,
+        activation_fn=nn.ReLU)`` is the plain MLP of 0.2.0
     :param verbose: the verbosity level: 0 no output, 1 info (including growth events), 2 debug
     :param seed: Seed for the pseudo random generators
     :param device: Device (cpu, cuda, ...) on which the code should be run ("auto": the GPU if there is one)
@@ -141,7 +145,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         batch_size: int = 256,
         tau: float = 1.0,
         gamma: float = 0.99,
-        train_freq: int | tuple[int, str] = 8,
+        train_freq: int | tuple[int, str] = 1,
         gradient_steps: int = 1,
         replay_buffer_class: type[ReplayBuffer] | None = None,
         replay_buffer_kwargs: dict[str, Any] | None = None,
@@ -158,7 +162,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         priority_exponent: float = 0.6,
         importance_sampling_exponent: float = 0.2,
         importance_sampling_annealing: bool = False,
-        bins: int | tuple[int, int] = (2, 9),
+        bins: int | tuple[int, int] = (3, 9),
         growth: str | None = "adaptive",
         growth_init: str = "interpolate",
         growth_eval_freq: int = 2_500,
@@ -219,7 +223,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             replay_buffer_kwargs=replay_buffer_kwargs,
             optimize_memory_usage=optimize_memory_usage,
             n_steps=learning["n_steps"],
-            policy_kwargs=policy_kwargs,
+            policy_kwargs=with_default_torso(policy_kwargs),
             stats_window_size=stats_window_size,
             tensorboard_log=tensorboard_log,
             verbose=verbose,

@@ -113,19 +113,17 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
         choices = int(np.ravel(action_space.nvec)[0])
     if choices is None:
         lines += [
-            "  bins: [2, 9]          # 9 -> 65 for velocity or position targets",
+            "  bins: [3, 9]          # [9, 65] for velocity or position targets",
             "  growth: 'adaptive'",
-            "  train_freq: 2",
             "  env_wrapper:",
             "    - sb3_gqn.common.wrappers.ActionPenalty:",
             "        coef: 0.1",
         ]
     elif choices >= 3 and ((choices - 1) & (choices - 2)) == 0:  # 3, 5, 9, 17, ...: nested levels from 2
         lines += [f"  bins: [2, {choices}]         # the env's {choices} choices, opened from 2", "  growth: 'adaptive'"]
-        lines += ["  train_freq: 2"]
     else:
         lines += [f"  bins: {choices}              # the env's {choices} choices, static"]
-        lines += ["  growth: null", "  train_freq: 2"]
+        lines += ["  growth: null"]
     return "\n".join(lines)
 
 
