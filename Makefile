@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv results test test-slow lint docs benchmark results-page constraints clean
+.PHONY: venv venv-myo results test test-slow lint docs benchmark results-page constraints clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -12,6 +12,15 @@ $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	touch $@
 
 venv: $(VENV)/.installed
+
+# MyoSuite's own environment: it cannot share one with Meta-World (mujoco 3.3.0 there, >= 3.4 here)
+MYO_VENV ?= .venv-myo
+$(MYO_VENV)/.installed: setup.cfg pyproject.toml constraints-myo.txt
+	$(PYTHON) -m venv $(MYO_VENV)
+	$(MYO_VENV)/bin/pip install --quiet --disable-pip-version-check -c constraints-myo.txt -e ".[myo,zoo,benchmark,tests]"
+	touch $@
+
+venv-myo: $(MYO_VENV)/.installed
 
 # Main job (~7-10 min on 2 cores): GQN on penalized cartpole-swingup (learning curve, final evaluation), then the
 # short comparison suite (GQN vs DecQN 2/9 vs SAC on penalized Pendulum: table and plots) into results/
