@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv venv-myo results test test-slow lint docs benchmark results-page constraints clean
+.PHONY: venv venv-myo results test test-slow test-myo lint docs benchmark results-page constraints constraints-myo clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -38,6 +38,11 @@ test: venv lint
 test-slow: venv
 	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)
 
+# MyoSuite's tests and its shipped entries, in its own environment (a missing myosuite fails instead of skipping)
+test-myo: venv-myo
+	SB3_GQN_REQUIRE_MYOSUITE=1 $(MYO_VENV)/bin/python -m pytest tests/test_myosuite.py \
+		tests/test_zoo.py::test_every_shipped_entry_builds_its_env_and_model -k "myo" $(PYTEST_ARGS)
+
 # The API documentation (Sphinx, from the docstrings) into docs/_build/html; warnings are errors
 docs: venv
 	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
@@ -59,5 +64,10 @@ constraints:
 	/tmp/sb3-gqn-constraints/bin/pip install --quiet -c constraints.txt ".[all,tests,docs]"
 	/tmp/sb3-gqn-constraints/bin/pip freeze | grep -v '^sb3-gqn' | sed 's/+cpu$$//'
 
+constraints-myo:
+	rm -rf /tmp/sb3-gqn-constraints-myo && $(PYTHON) -m venv /tmp/sb3-gqn-constraints-myo
+	/tmp/sb3-gqn-constraints-myo/bin/pip install --quiet -c constraints-myo.txt ".[myo,zoo,benchmark,tests]"
+	/tmp/sb3-gqn-constraints-myo/bin/pip freeze | grep -v '^sb3-gqn' | sed 's/+cpu$$//'
+
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache build *.egg-info docs/_build
+	rm -rf $(VENV) $(MYO_VENV) .pytest_cache .ruff_cache build *.egg-info docs/_build

@@ -134,3 +134,31 @@ def test_one_colour_per_agent_and_growth_steps_by_hand():
         }
     )
     assert growth_steps(runs) == {3: [5, 7], 5: [12, 15], 9: [18]}
+
+
+def test_success_is_a_third_panel_where_the_task_flags_it(tmp_path, monkeypatch):
+    rows = [
+        {"algo": "gqn", "env": env, "penalty": 0.5, "seed": seed, "step": step, "return": 1.0, "wall_time": 1.0,
+         "growth_events": "", "success": success}
+        for env, flags in (("metaworld", {0: (0.0, 1 / 3), 1: (1 / 3, 1.0)}), ("dmc", {0: (None, None), 1: (None, None)}))
+        for seed, per_step in flags.items()
+        for step, success in zip((100, 200), per_step)
+    ]  # fmt: skip
+    results = pd.DataFrame(rows)
+    # success at step 100: seeds 0 and 1 solved 0 and 1 of 3 episodes; at 200: 1 and 3 of 3
+    curve = plots.success_curve(results[results["env"] == "metaworld"])
+    np.testing.assert_allclose(curve["mean"], [1 / 6, 2 / 3])
+    np.testing.assert_array_equal(curve["count"], [2, 2])
+    assert plots.success_curve(results[results["env"] == "dmc"]) is None
+    panels = {}
+    real_subplots = plots.plt.subplots
+
+    def counting_subplots(rows: int, columns: int, **kwargs):
+        figure, axes = real_subplots(rows, columns, **kwargs)
+        panels[len(panels)] = columns
+        return figure, axes
+
+    monkeypatch.setattr(plots.plt, "subplots", counting_subplots)
+    paths = plots.learning_curves(results, tmp_path)
+    assert [path.name for path in paths] == ["learning_curves_dmc_c0.5.png", "learning_curves_metaworld_c0.5.png"]
+    assert list(panels.values()) == [2, 3]  # the task without the flag keeps two panels

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import ctypes.util
 import importlib
+import importlib.util
 import io
 import os
 from typing import Any
@@ -150,4 +151,9 @@ def register_envs() -> None:
         gym.register_envs(gymnasium_robotics)
     except ImportError:  # pragma: no cover - optional suite
         pass
+    if importlib.util.find_spec("myosuite") is not None:  # its own environment (make venv-myo)
+        # MyoSuite's mimic and challenge tasks fetch data from the Hugging Face Hub when made; nothing downloads at
+        # run time here: such a task fails at once with the hub's offline error (a user may set it to 0)
+        os.environ.setdefault("HF_HUB_OFFLINE", "1")
+        import myosuite  # noqa: F401  (registers the myo* ids)
     register_project_envs()

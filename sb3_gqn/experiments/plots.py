@@ -77,15 +77,31 @@ def mean_curve(runs: pd.DataFrame) -> pd.DataFrame:
     )
 
 
+def success_curve(runs: pd.DataFrame) -> pd.DataFrame | None:
+    """One agent's task success per evaluation step (the share of evaluation episodes whose final step the task
+    flagged as solved, see ``results.csv``'s ``success``): mean, std and run count over seeds; ``None`` for a task
+    without the flag."""
+    if "success" not in runs or runs["success"].isna().all():
+        return None
+    return (
+        runs.dropna(subset=["success"])
+        .groupby("step")
+        .agg(mean=("success", "mean"), std=("success", "std"), count=("success", "count"))
+    )
+
+
 def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None = None) -> list[Path]:
     """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band; the wall-time
-    axis places each evaluation at the seeds' median training time (:func:`mean_curve`).
+    axis places each evaluation at the seeds' median training time (:func:`mean_curve`). Tasks that flag success
+    (Meta-World, MyoSuite) get a third panel: the success rate vs env steps (:func:`success_curve`).
 
     ``warnings`` (e.g. runs whose budget never reached ``learning_starts``) are printed in red on every figure.
     """
     paths = []
     for (env, penalty), task in table.groupby(["env", "penalty"]):
-        figure, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        with_success = "success" in task and task["success"].notna().any()
+        figure, axes = plt.subplots(1, 3 if with_success else 2, figsize=(16 if with_success else 11, 4))
+        axes[1].sharey(axes[0])
         for index, warning in enumerate(warnings or []):
             figure.text(
                 0.5,
@@ -110,11 +126,22 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})", color=color)
                 axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2, color=color)
             _mark_growth_events(axes[0], runs, curve, color, below=algo in growing[1::2])
+            success = success_curve(runs)
+            if with_success and success is not None:
+                spread = 1.96 * success["std"].fillna(0.0) / np.sqrt(success["count"])
+                axes[2].plot(success.index.to_numpy(), success["mean"], color=color)
+                axes[2].fill_between(
+                    success.index.to_numpy(), success["mean"] - spread, success["mean"] + spread, alpha=0.2, color=color
+                )
         if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
             axes[0].errorbar([], [], xerr=[], fmt="v", color="grey", label="growth to n bins: median step, range over seeds")
         axes[0].set_xlabel("environment steps")
         axes[1].set_xlabel("training wall time [s], median over seeds")
         axes[0].set_ylabel("greedy return (penalized)")
+        if with_success:
+            axes[2].set_xlabel("environment steps")
+            axes[2].set_ylabel("success at the episode's final step")
+            axes[2].set_ylim(-0.05, 1.05)
         axes[0].legend(fontsize=8)
         spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
         figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
