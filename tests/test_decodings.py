@@ -64,3 +64,18 @@ def test_the_greedy_decoding_is_predict_and_the_comparison_has_a_row_per_decodin
     rows = compare_decodings(model, env, decodings, n_episodes=2)
     assert [row["decoding"] for row in rows] == ["greedy", "hysteresis 0.1", "softmax 0.1"]
     assert all(np.isfinite(row["return"]) and row["action_change"] >= 0 for row in rows)
+
+
+def test_the_command_prints_each_models_rows_and_their_means(tmp_path, capsys):
+    from sb3_gqn.experiments.decodings import main
+
+    pendulum_model(bins=(2, 9), growth=None).save(tmp_path / "model")
+    argv = [str(tmp_path / "model.zip"), "--env", "Pendulum-v1", "--episodes", "1", "--margins", "0.5"]
+    assert main([*argv, "--temperatures", "0.2"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split(" | ")[1] for line in lines[2:5]] == ["greedy", "hysteresis 0.5", "softmax 0.2"]
+    assert lines[6] == "Means over 1 models:" and [line.split(" | ")[0] for line in lines[10:]] == [
+        "| greedy",
+        "| hysteresis 0.5",
+        "| softmax 0.2",
+    ]

@@ -125,3 +125,45 @@ def compare_decodings(
             }
         )
     return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m sb3_gqn.experiments.decodings MODEL.zip ... --env ID --penalty C``: each model's greedy, hysteresis
+    and softmax-expectation figures (a Markdown table per model, then the means over the models)."""
+    import argparse
+
+    import pandas as pd
+
+    from sb3_gqn.common.envs import make_env
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("models", nargs="+")
+    parser.add_argument("--env", required=True)
+    parser.add_argument("--penalty", type=float, default=0.1)
+    parser.add_argument("--margins", type=float, nargs="*", default=[0.1, 0.3, 1.0, 3.0])
+    parser.add_argument("--temperatures", type=float, nargs="*", default=[0.03, 0.1, 0.3, 1.0])
+    parser.add_argument("--episodes", type=int, default=5)
+    args = parser.parse_args(argv)
+    rows = []
+    for path in args.models:
+        env = make_env(args.env, action_penalty=args.penalty)
+        model = GQN.load(path, env=env)
+        decodings = [Decoding(model), *(Hysteresis(model, m) for m in args.margins)]
+        decodings += [SoftmaxExpectation(model, t) for t in args.temperatures]
+        for row in compare_decodings(model, env, decodings, n_episodes=args.episodes):
+            rows.append({"model": path, **row})
+        env.close()
+    table = pd.DataFrame(rows)
+    columns = ["return", "task_return", "smoothness", "action_change"]
+    print("| model | decoding | return | task return | SM | |Δa| |\n| --- | --- | --- | --- | --- | --- |")
+    for _, row in table.iterrows():
+        print(f"| {row['model']} | {row['decoding']} | " + " | ".join(f"{row[c]:.4g}" for c in columns) + " |")
+    print(f"\nMeans over {len(args.models)} models:\n\n| decoding | return | task return | SM | |Δa| |")
+    print("| --- | --- | --- | --- | --- |")
+    for decoding, means in table.groupby("decoding", sort=False)[columns].mean().iterrows():
+        print(f"| {decoding} | " + " | ".join(f"{means[c]:.4g}" for c in columns) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
