@@ -52,6 +52,24 @@ def masked_argmax(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
     return q_values.masked_fill(~mask, -th.inf).argmax(dim=-1)
 
 
+#: How ``predict`` (deterministic) and the exports turn utilities into actions: the greedy bin (``"argmax"``, the
+#: paper) or, for a ``Box`` action space, the expected bin value under a softmax of the utilities (``"expectation"``)
+DECODINGS = ("argmax", "expectation")
+
+
+def masked_expectation(q_values: th.Tensor, mask: th.Tensor, bin_values: th.Tensor, temperature: float) -> th.Tensor:
+    """Expected bin value per dimension under ``softmax(q_values / temperature)`` over the active set.
+
+    :param q_values: utilities of shape ``(batch, action_dims, max_bins)``
+    :param mask: boolean tensor of shape ``(max_bins,)``, ``True`` = allowed (inactive bins get weight 0)
+    :param bin_values: each bin's env value, ``(action_dims, max_bins)``
+    :param temperature: in the utilities' units; towards 0 it is the greedy bin's value
+    :return: ``(batch, action_dims)``, inside the range of the active bins' values
+    """
+    weights = th.softmax(q_values.masked_fill(~mask, -th.inf) / temperature, dim=-1)
+    return (weights * bin_values).sum(dim=-1)
+
+
 def masked_max(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
     """Largest utility per dimension over the active set (shape ``q_values.shape[:-1]``)."""
     return q_values.masked_fill(~mask, -th.inf).amax(dim=-1)

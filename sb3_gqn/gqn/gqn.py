@@ -21,7 +21,13 @@ from sb3_gqn.common.arguments import check_choice, check_learning_arguments
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
-from sb3_gqn.common.masking import EXPLORATION_MODES, active_bin_indices, epsilon_greedy
+from sb3_gqn.common.masking import (
+    DECODINGS,
+    EXPLORATION_MODES,
+    active_bin_indices,
+    epsilon_greedy,
+    masked_expectation,
+)
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.common.torsos import with_default_torso
 from sb3_gqn.common.wrappers import BinGrid
@@ -111,6 +117,12 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     :param growth_probation: adaptive growth: ``None`` deploys a level when it opens (the paper as written); an int
         ``k`` keeps greedy actions and the TD target's max on the deployed level until a greedy episode over the opened
         one holds 70 % of its return, at most ``k`` tries (:class:`~sb3_gqn.gqn.growth.AdaptiveGrowth`)
+    :param decoding: how deterministic ``predict`` and the exports turn utilities into actions: ``"argmax"``, the
+        greedy bin (the paper); ``"expectation"`` (``Box`` action spaces), the expected bin value under a softmax of the
+        utilities over the deployed bins at ``decoding_temperature``, a continuous action that does not chatter
+        between neighbouring bins. Training (exploration, growth's greedy episodes, the TD target) is unchanged
+    :param decoding_temperature: the softmax temperature of ``decoding="expectation"``, in the utilities' units
+        (towards 0 it is the greedy bin)
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -172,6 +184,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         growth_patience: int | None = 2,
         growth_min_improvement: float = 0.05,
         growth_probation: int | None = None,
+        decoding: str = "argmax",
+        decoding_temperature: float = 0.3,
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
         policy_kwargs: dict[str, Any] | None = None,
@@ -202,6 +216,11 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         check_choice("growth", growth, GROWTH_SCHEDULES)
         check_choice("growth_init", growth_init, GROWTH_INITS)
         check_choice("exploration", exploration, EXPLORATION_MODES)
+        check_choice("decoding", decoding, DECODINGS)
+        if not (
+            isinstance(decoding_temperature, (int, float)) and np.isfinite(decoding_temperature) and decoding_temperature > 0
+        ):
+            raise ValueError(f"decoding_temperature must be a finite number > 0, got {decoding_temperature!r}")
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
         env = resolve_env(env)  # type: ignore[assignment]
@@ -240,6 +259,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         self.exploration_fraction = exploration_fraction
         self.exploration_rate = exploration_initial_eps
         self.exploration = exploration
+        self.decoding = decoding
+        self.decoding_temperature = float(decoding_temperature)
         self.max_grad_norm = max_grad_norm
         self.prioritized_replay = prioritized_replay
         self.priority_exponent = priority_exponent
@@ -278,6 +299,11 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         else:
             self.action_grid = None
             self.discrete_action_space = env_action_space
+        if getattr(self, "decoding", "argmax") == "expectation" and self.action_grid is None:
+            raise ValueError(
+                f"decoding='expectation' needs a Box action space (a continuous action between bin values); "
+                f"this env's is {env_action_space}: use decoding='argmax'"
+            )
         self.action_space = self.discrete_action_space
         # the policy keeps the averaged acting networks only when they are averaged (SB3 passes use_sde the same way)
         self.policy_kwargs.pop("averaged_acting", None)
@@ -394,6 +420,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         :return: the model's action and the next hidden state (used in recurrent policies)
         """
         check_finite_observation(as_batch(observation, self.observation_space), "predict()'s input")
+        if deterministic and self.decoding == "expectation" and self.action_grid is not None:
+            return self._expected_action(observation), state
         actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
         if not deterministic:
             deployed_indices = active_bin_indices(self.bin_levels[-1], self.deployed_bins)
@@ -401,6 +429,19 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
                 np.asarray(actions), deployed_indices, self.exploration_rate, exploration=self.exploration
             )
         return self.to_env_action(actions), state
+
+    def _expected_action(self, observation: np.ndarray | dict[str, np.ndarray]) -> np.ndarray:
+        """``decoding="expectation"``: each dimension's expected bin value under the softmax of the acting
+        utilities over the deployed bins (:func:`~sb3_gqn.common.masking.masked_expectation`)."""
+        grid = self.action_grid
+        assert grid is not None
+        obs_tensor, vectorized = self.policy.obs_to_tensor(observation)
+        with th.no_grad():
+            utilities = self.policy.greedy_utilities(obs_tensor)
+            bin_values = th.as_tensor(grid.values, device=utilities.device, dtype=utilities.dtype)
+            values = masked_expectation(utilities, self.policy.active_bins_mask, bin_values, self.decoding_temperature)
+        actions = values.cpu().numpy().reshape((-1, *grid.box.shape)).astype(grid.box.dtype)
+        return actions if vectorized else actions[0]
 
     def _store_transition(
         self,

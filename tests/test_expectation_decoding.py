@@ -1,0 +1,95 @@
+"""``decoding="expectation"``: the expected bin value under a softmax of the utilities, in ``predict`` and the exports."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch as th
+
+from sb3_gqn import GQN
+from sb3_gqn.common.masking import masked_expectation
+from sb3_gqn.export import export_onnx, export_torchscript
+from tests.test_export import observations, run_onnx, run_torchscript
+
+onnxruntime = pytest.importorskip("onnxruntime")
+
+
+def pendulum_model(**kwargs) -> GQN:
+    model = GQN("MlpPolicy", "Pendulum-v1", bins=(2, 9), growth=None, policy_kwargs=dict(net_arch=[16]), seed=0, **kwargs)
+    model.grow(2)  # 5 of 9 bins active: the mask matters
+    return model
+
+
+def test_the_expectation_weighs_the_active_bins_by_their_softmax():
+    # utilities 0 and ln 3 on the two active bins (the third masked): weights 1/4 and 3/4 at temperature 1
+    utilities = th.tensor([[[0.0, math.log(3.0), 100.0]]])
+    mask = th.tensor([True, True, False])
+    values = th.tensor([[-2.0, 0.0, 2.0]])
+    assert masked_expectation(utilities, mask, values, 1.0).item() == pytest.approx(-0.5)
+    # the temperature divides the utilities: 0 and 2 ln 3 at temperature 2 are the same weights
+    assert masked_expectation(utilities * 2, mask, values, 2.0).item() == pytest.approx(-0.5)
+    # towards 0 it is the greedy bin's value
+    assert masked_expectation(utilities, mask, values, 1e-4).item() == pytest.approx(0.0)
+
+
+def test_predict_returns_the_expectation_and_explores_over_bins_as_before():
+    model = pendulum_model(decoding="expectation", decoding_temperature=0.5)
+    batch = observations(model.observation_space, count=64)
+    actions, _ = model.predict(batch, deterministic=True)
+    utilities = model.policy.greedy_utilities(model.policy.obs_to_tensor(batch)[0]).detach().numpy()[:, 0, :]
+    active = [0, 2, 4, 6, 8]  # 5 of 9 bins: values -2, -1, 0, 1, 2
+    weights = np.exp((utilities[:, active] - utilities[:, active].max(axis=1, keepdims=True)) / 0.5)
+    weights /= weights.sum(axis=1, keepdims=True)
+    np.testing.assert_allclose(actions[:, 0], weights @ np.array([-2.0, -1.0, 0.0, 1.0, 2.0]), rtol=1e-5, atol=1e-6)
+    assert actions.shape == (64, 1) and actions.dtype == np.float32
+    single, _ = model.predict(batch[0], deterministic=True)
+    assert single.shape == (1,) and single[0] == pytest.approx(actions[0, 0], abs=1e-6)
+    # exploration (deterministic=False) still acts on bins: every action is one of the active bins' values
+    model.exploration_rate = 1.0
+    explored, _ = model.predict(batch, deterministic=False)
+    assert set(np.unique(explored)) <= {-2.0, -1.0, 0.0, 1.0, 2.0}
+
+
+@pytest.mark.parametrize("runtime", ["torchscript", "onnx"])
+def test_the_exports_act_as_predict_does(runtime, tmp_path):
+    model = pendulum_model(decoding="expectation", decoding_temperature=0.3)
+    batch = observations(model.observation_space)
+    expected, _ = model.predict(batch, deterministic=True)
+    if runtime == "torchscript":
+        actions = run_torchscript(export_torchscript(model, tmp_path / "policy.pt"), batch)
+    else:
+        actions = run_onnx(export_onnx(model, tmp_path / "policy.onnx"), batch)
+    np.testing.assert_allclose(actions, expected, rtol=1e-5, atol=1e-6)
+    greedy, _ = pendulum_model().predict(batch, deterministic=True)
+    assert not np.allclose(actions, greedy)  # the export did not fall back to the greedy bin
+
+
+def test_learn_save_and_load_keep_the_decoding(tmp_path):
+    model = GQN("MlpPolicy", "Pendulum-v1", decoding="expectation", decoding_temperature=0.2, learning_starts=50,
+                policy_kwargs=dict(net_arch=[16]), seed=0).learn(120)  # fmt: skip
+    model.save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model")
+    assert (loaded.decoding, loaded.decoding_temperature) == ("expectation", 0.2)
+    batch = observations(model.observation_space, count=8)
+    np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], model.predict(batch, deterministic=True)[0])
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation'\), got 'median'"),
+        (dict(decoding="expectation", decoding_temperature=0.0), "decoding_temperature must be a finite number > 0"),
+        (dict(decoding_temperature=float("nan")), "decoding_temperature must be a finite number > 0"),
+    ],
+)
+def test_bad_decoding_arguments_are_refused(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        GQN("MlpPolicy", "Pendulum-v1", **kwargs)
+
+
+def test_the_expectation_needs_a_box_action_space():
+    with pytest.raises(ValueError, match="decoding='expectation' needs a Box action space"):
+        GQN("MlpPolicy", gym.make("CartPole-v1"), bins=2, growth=None, decoding="expectation")
