@@ -291,6 +291,28 @@ def test_the_results_page_task_table_by_hand():
     assert body[2] == "| cartpole-swingup | 7 (1 seed), SM 0.0200 | 5 [0, 10] (2 seeds), SM 0.0200 |"
 
 
+def test_the_development_table_reads_the_final_evaluations_and_success(tmp_path):
+    """Meta-World reach: W ends at 10 and 20 over two seeds (success 1 and 0), SAC at 4 on one (no flag recorded);
+    reacher has no success column values. Earlier evaluations (step 25k) are ignored."""
+    import pandas as pd
+
+    w = "gqn-adaptive+layernorm+1update+bins3-9"
+    rows = [
+        {"algo": algo, "env": env, "penalty": 0.5, "seed": seed, "step": step, "return": value if step == 50_000 else -1.0,
+         "success": flag}
+        for algo, env, seed, value, flag in [
+            (w, "sb3_gqn/metaworld-reach-v3", 0, 10.0, 1.0), (w, "sb3_gqn/metaworld-reach-v3", 1, 20.0, 0.0),
+            ("sac", "sb3_gqn/metaworld-reach-v3", 0, 4.0, None), (w, "dm_control/reacher-easy-v0", 0, -3.0, None),
+        ]
+        for step in (25_000, 50_000)
+    ]  # fmt: skip
+    pd.DataFrame(rows).to_csv(tmp_path / "results.csv", index=False)
+    body = results_page().development_block(tmp_path / "results.csv").splitlines()
+    assert body[0] == "| task | c | GQN (defaults) | SAC |"
+    assert body[2] == "| reacher-easy | 0.5 | -3 (1) | - |"
+    assert body[3] == "| reach-v3 | 0.5 | 15 [10, 20] (2), success 0.50 | 4 (1) |"
+
+
 @pytest.mark.parametrize(
     "module", ["sb3_gqn.experiments.runner", "sb3_gqn.experiments.reference_run", "sb3_gqn.experiments.report"]
 )
