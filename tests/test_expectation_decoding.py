@@ -81,8 +81,12 @@ def test_learn_save_and_load_keep_the_decoding(tmp_path):
     "kwargs, message",
     [
         (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation'\), got 'median'"),
-        (dict(decoding="expectation", decoding_temperature=0.0), "decoding_temperature must be a finite number > 0"),
-        (dict(decoding_temperature=float("nan")), "decoding_temperature must be a finite number > 0"),
+        (
+            dict(decoding="expectation", decoding_temperature=0.0),
+            r"decoding_temperature must be a finite number in \(0, inf\)",
+        ),
+        (dict(decoding_temperature=float("nan")), r"decoding_temperature must be a finite number in \(0, inf\), got nan"),
+        (dict(decoding_temperature=True), r"decoding_temperature must be a finite number in \(0, inf\), got True"),
     ],
 )
 def test_bad_decoding_arguments_are_refused(kwargs, message):

@@ -17,7 +17,7 @@ from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedul
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.common.arguments import check_choice, check_learning_arguments
+from sb3_gqn.common.arguments import check_choice, check_learning_arguments, check_number
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
@@ -217,10 +217,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         check_choice("growth_init", growth_init, GROWTH_INITS)
         check_choice("exploration", exploration, EXPLORATION_MODES)
         check_choice("decoding", decoding, DECODINGS)
-        if not (
-            isinstance(decoding_temperature, (int, float)) and np.isfinite(decoding_temperature) and decoding_temperature > 0
-        ):
-            raise ValueError(f"decoding_temperature must be a finite number > 0, got {decoding_temperature!r}")
+        decoding_temperature = check_number("decoding_temperature", decoding_temperature, low=0.0, low_open=True)
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
         env = resolve_env(env)  # type: ignore[assignment]
