@@ -21,6 +21,7 @@ import numpy as np
 import torch as th
 
 from sb3_gqn.common.evaluation import rollout_figures
+from sb3_gqn.common.masking import masked_expectation
 from sb3_gqn.gqn.gqn import GQN
 
 
@@ -86,12 +87,12 @@ class SoftmaxExpectation(Decoding):
         self.name = f"softmax {temperature:g}"
 
     def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True) -> Any:
-        utilities = self.utilities(observation) / self.temperature
-        weights = np.exp(utilities - utilities.max(axis=1, keepdims=True))  # exp(-inf) = 0 on inactive bins
-        weights /= weights.sum(axis=1, keepdims=True)
         grid = self.model.action_grid
         assert grid is not None
-        values = (weights * grid.values).sum(axis=1)
+        utilities = th.as_tensor(self.utilities(observation))  # -inf on inactive bins: weight 0
+        mask = self.model.policy.active_bins_mask.cpu()
+        bin_values = th.as_tensor(grid.values, dtype=utilities.dtype)
+        values = masked_expectation(utilities[None], mask, bin_values, self.temperature)[0].numpy()
         return values.reshape(grid.box.shape).astype(grid.box.dtype), state
 
 
