@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from sb3_gqn.common.wrappers import ActionPenalty, DiscretizeAction
+from sb3_gqn.common.wrappers import ActionPenalty, DiscretizeAction, rescale_to_unit
 
 
 class RecordingEnv(gym.Env):
@@ -88,3 +88,10 @@ def test_action_penalty_rejects_bad_input():
         ActionPenalty(RecordingEnv(), coef=float("nan"))
     with pytest.raises(ValueError):
         ActionPenalty(RecordingEnv(), coef=-1.0)
+
+
+def test_rescale_to_unit_by_hand():
+    # low = (-2, 0), high = (2, 10): 1 -> 2 * 3 / 4 - 1 = 0.5; 2.5 -> 2 * 2.5 / 10 - 1 = -0.5; the bounds -> -1 and 1
+    low, high = np.array([-2.0, 0.0]), np.array([2.0, 10.0])
+    np.testing.assert_allclose(rescale_to_unit([1.0, 2.5], low, high), [0.5, -0.5])
+    np.testing.assert_allclose(rescale_to_unit([[-2.0, 10.0], [2.0, 0.0]], low, high), [[-1.0, 1.0], [1.0, -1.0]])

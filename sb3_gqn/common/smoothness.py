@@ -10,6 +10,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from sb3_gqn.common.wrappers import rescale_to_unit
+
 if TYPE_CHECKING:
     from sb3_gqn.common.evaluation import Episode
 
@@ -104,8 +106,7 @@ def control_frequency(env: gym.Env) -> float | None:
 
 def normalized_actions(actions: np.ndarray, action_space: spaces.Box) -> np.ndarray:
     """Actions rescaled from ``[low, high]`` to ``[-1, 1]`` per dimension."""
-    low, high = action_space.low.astype(np.float64), action_space.high.astype(np.float64)
-    return 2.0 * (np.asarray(actions, dtype=np.float64) - low) / (high - low) - 1.0
+    return rescale_to_unit(actions, action_space.low.astype(np.float64), action_space.high.astype(np.float64))
 
 
 @dataclass

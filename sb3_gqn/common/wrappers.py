@@ -88,6 +88,15 @@ class DiscretizeAction(gym.ActionWrapper):
         return self.grid.to_continuous(np.asarray(action).reshape(self.grid.action_dims))
 
 
+def rescale_to_unit(actions: Any, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """``2 (a - low) / (high - low) - 1``: actions rescaled from ``[low, high]`` to ``[-1, 1]`` per dimension.
+
+    The one rescaling the penalty wrappers and the smoothness figures share; ``low`` and ``high`` broadcast against
+    ``actions`` (one action or a batch).
+    """
+    return 2.0 * (np.asarray(actions, dtype=np.float64) - low) / (high - low) - 1.0
+
+
 def penalty_bounds(env: gym.Env, coef: float, wrapper: str, what: str) -> tuple[float, np.ndarray, np.ndarray]:
     """A penalty wrapper's checked coefficient and its env's action bounds (flattened, float64)."""
     box = check_finite_box(env.action_space, f"{wrapper} (apply it before DiscretizeAction)")
@@ -115,7 +124,7 @@ class ActionPenalty(gym.Wrapper):
 
     def penalty(self, action: np.ndarray) -> float:
         """``coef * sum(a_norm ** 2)`` for one action."""
-        normalized = 2.0 * (np.asarray(action, dtype=np.float64) - self._low) / (self._high - self._low) - 1.0
+        normalized = rescale_to_unit(action, self._low, self._high)
         return self.coef * float(np.sum(normalized**2))
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
@@ -172,8 +181,7 @@ class ActionRatePenalty(gym.Wrapper):
 
     def normalize(self, action: Any) -> np.ndarray:
         """The action rescaled to ``[-1, 1]`` per dimension (flattened)."""
-        action = np.asarray(action, dtype=np.float64).reshape(-1)
-        return 2.0 * (action - self._low) / (self._high - self._low) - 1.0
+        return rescale_to_unit(np.asarray(action).reshape(-1), self._low, self._high)
 
     def _observation(self, observation: Any) -> Any:
         previous = self.previous_action.astype(np.float32)
