@@ -5,6 +5,7 @@ import math
 
 import gymnasium as gym
 import numpy as np
+import pandas as pd
 import pytest
 
 from sb3_gqn import GQN
@@ -71,7 +72,7 @@ def test_the_command_prints_each_models_rows_and_their_means(tmp_path, capsys):
 
     pendulum_model(bins=(2, 9), growth=None).save(tmp_path / "model")
     argv = [str(tmp_path / "model.zip"), "--env", "Pendulum-v1", "--episodes", "1", "--margins", "0.5"]
-    assert main([*argv, "--temperatures", "0.2"]) == 0
+    assert main([*argv, "--temperatures", "0.2", "--csv", str(tmp_path / "rows.csv")]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert [line.split(" | ")[1] for line in lines[2:5]] == ["greedy", "hysteresis 0.5", "softmax 0.2"]
     assert lines[6] == "Means over 1 models:" and [line.split(" | ")[0] for line in lines[10:]] == [
@@ -79,3 +80,6 @@ def test_the_command_prints_each_models_rows_and_their_means(tmp_path, capsys):
         "| hysteresis 0.5",
         "| softmax 0.2",
     ]
+    written = pd.read_csv(tmp_path / "rows.csv")
+    assert list(written["decoding"]) == ["greedy", "hysteresis 0.5", "softmax 0.2"]
+    assert list(written.columns) == ["model", "decoding", "return", "task_return", "smoothness", "action_change"]

@@ -130,7 +130,8 @@ def compare_decodings(
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m sb3_gqn.experiments.decodings MODEL.zip ... --env ID --penalty C``: each model's greedy, hysteresis
-    and softmax-expectation figures (a Markdown table per model, then the means over the models)."""
+    and softmax-expectation figures (a Markdown table per model, then the means over the models; ``--csv`` also writes
+    the rows)."""
     import argparse
 
     import pandas as pd
@@ -144,6 +145,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--margins", type=float, nargs="*", default=[0.1, 0.3, 1.0, 3.0])
     parser.add_argument("--temperatures", type=float, nargs="*", default=[0.03, 0.1, 0.3, 1.0])
     parser.add_argument("--episodes", type=int, default=5)
+    parser.add_argument("--csv", help="also write every model's rows to this CSV file")
     args = parser.parse_args(argv)
     rows = []
     for path in args.models:
@@ -155,6 +157,8 @@ def main(argv: list[str] | None = None) -> int:
             rows.append({"model": path, **row})
         env.close()
     table = pd.DataFrame(rows)
+    if args.csv:
+        table.to_csv(args.csv, index=False)
     columns = ["return", "task_return", "smoothness", "action_change"]
     print("| model | decoding | return | task return | SM | |Δa| |\n| --- | --- | --- | --- | --- | --- |")
     for _, row in table.iterrows():
