@@ -313,6 +313,57 @@ def test_the_development_table_reads_the_final_evaluations_and_success(tmp_path)
     assert body[3] == "| reach-v3 | 0.5 | 15 [10, 20] (2), success 0.50 | 4 (1) |"
 
 
+def test_the_smooth_control_table_by_hand(tmp_path):
+    """cartpole: the shipped entry's seeds 0-1 (seed 2 has no remedy run, so it is left out) end at task return 100
+    and 100, SM 0.004 and 0.006; the remedy at 150 and 150, SM 0.001 and 0.003 (mean 0.002, bootstrap interval
+    [0.001, 0.003]: the replicates of two values are 0.001, 0.002 or 0.003); SAC at 100 (3 seeds), SM 0.002. So SM
+    1.00x SAC's, task return +50 [+50, +50] against both."""
+    import pandas as pd
+
+    env = "dm_control/cartpole-swingup-v0"
+
+    def run(algo, seed, task_return, sm, change):
+        return {
+            "algo": algo,
+            "env": env,
+            "penalty": 0.1,
+            "seed": seed,
+            "step": 100_000,
+            "return": task_return,
+            "task_return": task_return,
+            "smoothness": sm,
+            "action_change": change,
+        }
+
+    comparison = pd.DataFrame(
+        [run("gqn-adaptive", 0, 100.0, 0.004, 0.2), run("gqn-adaptive", 1, 100.0, 0.006, 0.2),
+         run("gqn-adaptive", 2, 999.0, 0.5, 0.9)] + [run("sac", seed, 100.0, 0.002, 0.01) for seed in range(3)]
+    )  # fmt: skip
+    page = results_page()
+    remedy = [run(page.SMOOTH_REMEDY, 0, 150.0, 0.001, 0.02), run(page.SMOOTH_REMEDY, 1, 150.0, 0.003, 0.02)]
+    early = [{**row, "step": 50_000, "task_return": -5.0} for row in remedy]
+    pd.DataFrame(early + remedy).to_csv(tmp_path / "results.csv", index=False)
+    model = f"runs/{page.SMOOTH_REMEDY}__dm_control-cartpole-swingup-v0__c0.1__seed{{}}/model.zip"
+    pd.DataFrame(
+        [{"model": model.format(seed), "decoding": decoding, "return": value, "task_return": value,
+          "smoothness": sm, "action_change": 0.1} for seed in (0, 1)
+         for decoding, value, sm in [("greedy", 140.0, 0.005), ("softmax 0.3", 150.0, 0.001), ("hysteresis 0.1", 0.0, 0.0)]]
+    ).to_csv(tmp_path / "decodings.csv", index=False)  # fmt: skip
+    body = page.smooth_control_block(comparison, tmp_path).splitlines()
+    assert body[0] == "**cartpole-swingup**"
+    assert body[4] == "| GQN, argmax (shipped entry) | 2 | 100 [100, 100] | 0.0050 [0.0040, 0.0060] | 0.200 [0.200, 0.200] |"
+    assert body[5] == "| GQN, expectation 0.3 | 2 | 150 [150, 150] | 0.0020 [0.0010, 0.0030] | 0.020 [0.020, 0.020] |"
+    assert body[6] == (
+        "| GQN, argmax, on the same final models | 2 | 140 [140, 140] | 0.0050 [0.0050, 0.0050] | 0.100 [0.100, 0.100] |"
+    )
+    assert body[7].startswith("| GQN, expectation 0.3, on the same final models | 2 | 150 [150, 150] | 0.0010")
+    assert body[8] == "| SAC | 3 | 100 [100, 100] | 0.0020 [0.0020, 0.0020] | 0.010 [0.010, 0.010] |"
+    assert body[10] == (
+        "SM 1.00x SAC's (goal: at most 1.5x); task return minus the shipped entry's +50 [+50, +50], minus SAC's +50 "
+        "[+50, +50]."
+    )
+
+
 @pytest.mark.parametrize(
     "module", ["sb3_gqn.experiments.runner", "sb3_gqn.experiments.reference_run", "sb3_gqn.experiments.report"]
 )

@@ -15,12 +15,13 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
 from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
 from sb3_gqn.experiments.scores import final_rows
-from sb3_gqn.experiments.significance import mean_interval
+from sb3_gqn.experiments.significance import difference_interval, mean_difference, mean_interval
 from sb3_gqn.experiments.variants import load_variants
 
 RESULTS = Path("docs/results")
@@ -58,6 +59,16 @@ DEVELOPMENT_AGENTS = {
     "sac": "SAC",
     "gqn-adaptive-0.2": "GQN (0.2.0 defaults)",
 }
+
+
+#: The smooth-control evidence (docs/research/smooth-control.md): the runner's runs of the remedy, and every final model
+#: of them read with the greedy argmax and with the remedy's decoding (``python -m sb3_gqn.experiments.decodings
+#: ... --csv``), so the two decodings compare on the same models
+SMOOTH_CONTROL = RESULTS / "smooth-control"
+SMOOTH_REMEDY = "gqn-adaptive+expectation0.3"
+SMOOTH_DECODINGS = {"greedy": "argmax", "softmax 0.3": "expectation 0.3"}
+#: the goal: SM at most this multiple of SAC's
+SMOOTHNESS_GOAL = 1.5
 
 
 def shipped(table: pd.DataFrame) -> pd.DataFrame:
@@ -175,6 +186,62 @@ def development_block(path: Path = DEVELOPMENT) -> str:
         task = str(env).split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
         lines.append(f"| {task} | {penalty:g} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def interval_cell(values: np.ndarray, digits: int) -> str:
+    """``mean [low, high]`` of ``values`` with the 95 % bootstrap interval, ``digits`` decimals (one value: the mean)."""
+    mean, (low, high) = mean_interval(values)
+    return f"{mean:.{digits}f}" + (f" [{low:.{digits}f}, {high:.{digits}f}]" if len(values) > 1 else "")
+
+
+def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) -> str:
+    """The smooth-control evidence per task: task return, SM and ``|Δa|`` at the final evaluation, mean [95 % interval]
+    over seeds, for the shipped GQN entry (the committed runs of the remedy's seeds), the remedy (the runner's runs),
+    both decodings read on the remedy's final models (``decodings.csv``) and SAC (every committed seed); then the goal:
+    the remedy's SM against :data:`SMOOTHNESS_GOAL` x SAC's, its task return against the shipped entry's and SAC's
+    (difference of means [95 % interval])."""
+    remedy = final_rows(load([path / "results.csv"]))
+    remedy = remedy[remedy["algo"] == SMOOTH_REMEDY]
+    decodings = pd.read_csv(path / "decodings.csv") if (path / "decodings.csv").exists() else None
+    final = final_rows(comparison)
+    lines = []
+    for env, remedy_runs in remedy.groupby("env"):
+        seeds = sorted(remedy_runs["seed"])
+        task = str(env).split("/")[-1].removesuffix("-v0")
+        runs = final[final["env"] == env]
+        rows = {
+            "GQN, argmax (shipped entry)": runs[(runs["algo"] == "gqn-adaptive") & runs["seed"].isin(seeds)],
+            "GQN, expectation 0.3": remedy_runs,
+        }
+        if decodings is not None:
+            models = decodings[decodings["model"].str.contains(f"__{str(env).replace('/', '-')}__")]
+            for decoding, label in SMOOTH_DECODINGS.items():
+                rows[f"GQN, {label}, on the same final models"] = models[models["decoding"] == decoding]
+        rows["SAC"] = runs[runs["algo"] == "sac"]
+        lines += [f"**{task}**", "", "| agent | seeds | task return | SM | \\|Δa\\| |", "| --- | --- | --- | --- | --- |"]
+        for label, agent_runs in rows.items():
+            cells = [
+                interval_cell(agent_runs["task_return"].to_numpy(), 0),
+                interval_cell(agent_runs["smoothness"].to_numpy(), 4),
+                interval_cell(agent_runs["action_change"].to_numpy(), 3),
+            ]
+            lines.append(f"| {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
+        shipped_runs, sac = rows["GQN, argmax (shipped entry)"], rows["SAC"]
+        ratio = remedy_runs["smoothness"].mean() / sac["smoothness"].mean()
+        versus_shipped, (low, high) = difference_interval(
+            mean_difference, remedy_runs["task_return"].to_numpy(), shipped_runs["task_return"].to_numpy()
+        )
+        versus_sac, (sac_low, sac_high) = difference_interval(
+            mean_difference, remedy_runs["task_return"].to_numpy(), sac["task_return"].to_numpy()
+        )
+        lines += [
+            "",
+            f"SM {ratio:.2f}x SAC's (goal: at most {SMOOTHNESS_GOAL:g}x); task return minus the shipped entry's "
+            f"{versus_shipped:+.0f} [{low:+.0f}, {high:+.0f}], minus SAC's {versus_sac:+.0f} "
+            f"[{sac_low:+.0f}, {sac_high:+.0f}].",
+            "",
+        ]
+    return "\n".join(lines).strip()
 
 
 def replace_block(path: Path, name: str, body: str) -> None:
