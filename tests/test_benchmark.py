@@ -348,7 +348,7 @@ def test_the_smooth_control_table_by_hand(tmp_path):
         [{"model": model.format(seed), "decoding": decoding, "return": value, "task_return": value,
           "smoothness": sm, "action_change": 0.1} for seed in (0, 1)
          for decoding, value, sm in [("greedy", 140.0, 0.005), ("softmax 0.3", 150.0, 0.001), ("hysteresis 0.1", 0.0, 0.0)]]
-    ).to_csv(tmp_path / "decodings.csv", index=False)  # fmt: skip
+    ).to_csv(tmp_path / "decodings-cartpole.csv", index=False)  # fmt: skip
     body = page.smooth_control_block(comparison, tmp_path).splitlines()
     assert body[0] == "**cartpole-swingup**"
     assert body[4] == "| GQN, argmax (shipped entry) | 2 | 100 [100, 100] | 0.0050 [0.0040, 0.0060] | 0.200 [0.200, 0.200] |"

@@ -63,7 +63,7 @@ DEVELOPMENT_AGENTS = {
 
 #: The smooth-control evidence (docs/research/smooth-control.md): the runner's runs of the remedy, and every final model
 #: of them read with the greedy argmax and with the remedy's decoding (``python -m sb3_gqn.experiments.decodings
-#: ... --csv``), so the two decodings compare on the same models
+#: ... --csv decodings-<task>.csv``), so the two decodings compare on the same models
 SMOOTH_CONTROL = RESULTS / "smooth-control"
 SMOOTH_REMEDY = "gqn-adaptive+expectation0.3"
 SMOOTH_DECODINGS = {"greedy": "argmax", "softmax 0.3": "expectation 0.3"}
@@ -197,12 +197,13 @@ def interval_cell(values: np.ndarray, digits: int) -> str:
 def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) -> str:
     """The smooth-control evidence per task: task return, SM and ``|Δa|`` at the final evaluation, mean [95 % interval]
     over seeds, for the shipped GQN entry (the committed runs of the remedy's seeds), the remedy (the runner's runs),
-    both decodings read on the remedy's final models (``decodings.csv``) and SAC (every committed seed); then the goal:
+    both decodings read on the remedy's final models (``decodings-<task>.csv``) and SAC (every committed seed); then the goal:
     the remedy's SM against :data:`SMOOTHNESS_GOAL` x SAC's, its task return against the shipped entry's and SAC's
     (difference of means [95 % interval])."""
     remedy = final_rows(load([path / "results.csv"]))
     remedy = remedy[remedy["algo"] == SMOOTH_REMEDY]
-    decodings = pd.read_csv(path / "decodings.csv") if (path / "decodings.csv").exists() else None
+    decoding_tables = [pd.read_csv(table) for table in sorted(path.glob("decodings-*.csv"))]
+    decodings = pd.concat(decoding_tables, ignore_index=True) if decoding_tables else None
     final = final_rows(comparison)
     lines = []
     for env, remedy_runs in remedy.groupby("env"):
