@@ -313,6 +313,27 @@ def test_the_development_table_reads_the_final_evaluations_and_success(tmp_path)
     assert body[3] == "| reach-v3 | 0.5 | 15 [10, 20] (2), success 0.50 | 4 (1) |"
 
 
+def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
+    """The README's and the results page's generated tables are what docs/results/build.py makes of the committed
+    results.csv files: a table extended without `make results-page` fails here."""
+    from sb3_gqn.experiments.variants import load_variants
+
+    root = Path(__file__).parents[1]
+    monkeypatch.chdir(root)
+    page = results_page()
+    load_variants(page.RESEARCH_VARIANTS)
+
+    def block(path, name):
+        after_begin = path.read_text().split(f"<!-- BEGIN generated: {name} -->\n", 1)[1]
+        return after_begin.split(f"\n<!-- END generated: {name} -->")[0]
+
+    table = page.comparison_table()
+    assert block(page.README, "development") == page.development_block()
+    assert block(page.README, "results") == page.task_table(table)
+    if len(page.smooth_control_runs()):
+        assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
+
+
 def test_the_smooth_control_table_by_hand(tmp_path):
     """cartpole: the shipped entry's seeds 0-1 (seed 2 has no remedy run, so it is left out) end at task return 100
     and 100, SM 0.004 and 0.006; the remedy at 150 and 150, SM 0.001 and 0.003 (mean 0.002, bootstrap interval
