@@ -89,9 +89,26 @@ def test_learn_save_and_load_keep_the_decoding(tmp_path):
         (dict(decoding_temperature=True), r"decoding_temperature must be a finite number in \(0, inf\), got True"),
     ],
 )
-def test_bad_decoding_arguments_are_refused(kwargs, message):
+def test_bad_decoding_arguments_are_refused(kwargs, message, tmp_path):
     with pytest.raises(ValueError, match=message):
         GQN("MlpPolicy", "Pendulum-v1", **kwargs)
+    # load() sets its keyword arguments on the model: the same checks apply there
+    GQN("MlpPolicy", "Pendulum-v1", policy_kwargs=dict(net_arch=[16])).save(tmp_path / "model")
+    with pytest.raises(ValueError, match=message):
+        GQN.load(tmp_path / "model", **kwargs)
+
+
+def test_a_trained_argmax_model_switches_to_the_expectation_at_load(tmp_path):
+    """Training is the same for both decodings, so a model trained with the argmax can act on the expectation: its
+    deterministic action is then the softmax-weighted bin value (tested against masked_expectation)."""
+    model = pendulum_model()
+    model.save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model", decoding="expectation", decoding_temperature=0.5)
+    batch = observations(model.observation_space, count=8)
+    utilities = model.policy.greedy_utilities(model.policy.obs_to_tensor(batch)[0]).detach()
+    bin_values = th.as_tensor(model.action_grid.values, dtype=utilities.dtype)
+    expected = masked_expectation(utilities, model.policy.active_bins_mask, bin_values, 0.5).numpy()
+    np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], expected.reshape(-1, 1), rtol=1e-5, atol=1e-6)
 
 
 def test_the_expectation_needs_a_box_action_space():

@@ -296,7 +296,13 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         else:
             self.action_grid = None
             self.discrete_action_space = env_action_space
-        if getattr(self, "decoding", "argmax") == "expectation" and self.action_grid is None:
+        # load() sets its keyword arguments on the model before this runs: check them as the constructor does
+        self.decoding = getattr(self, "decoding", "argmax")  # models saved before the option act on the argmax
+        check_choice("decoding", self.decoding, DECODINGS)
+        self.decoding_temperature = check_number(
+            "decoding_temperature", getattr(self, "decoding_temperature", 0.3), low=0.0, low_open=True
+        )
+        if self.decoding == "expectation" and self.action_grid is None:
             raise ValueError(
                 f"decoding='expectation' needs a Box action space (a continuous action between bin values); "
                 f"this env's is {env_action_space}: use decoding='argmax'"
