@@ -46,6 +46,13 @@ from sb3_gqn.gqn.saving import SavedFiles
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
+def checked_decoding(decoding: str, temperature: float) -> tuple[str, float]:
+    """``decoding`` and ``decoding_temperature`` checked (the constructor and ``load``'s keyword arguments): one of
+    :data:`~sb3_gqn.common.masking.DECODINGS`, and a finite temperature > 0 (as a float)."""
+    check_choice("decoding", decoding, DECODINGS)
+    return decoding, float(check_number("decoding_temperature", temperature, low=0.0, low_open=True))
+
+
 class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     """
     Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose resolution grows from
@@ -216,8 +223,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         check_choice("growth", growth, GROWTH_SCHEDULES)
         check_choice("growth_init", growth_init, GROWTH_INITS)
         check_choice("exploration", exploration, EXPLORATION_MODES)
-        check_choice("decoding", decoding, DECODINGS)
-        decoding_temperature = check_number("decoding_temperature", decoding_temperature, low=0.0, low_open=True)
+        decoding, decoding_temperature = checked_decoding(decoding, decoding_temperature)
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
         env = resolve_env(env)  # type: ignore[assignment]
@@ -257,7 +263,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         self.exploration_rate = exploration_initial_eps
         self.exploration = exploration
         self.decoding = decoding
-        self.decoding_temperature = float(decoding_temperature)
+        self.decoding_temperature = decoding_temperature
         self.max_grad_norm = max_grad_norm
         self.prioritized_replay = prioritized_replay
         self.priority_exponent = priority_exponent
@@ -297,10 +303,9 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             self.action_grid = None
             self.discrete_action_space = env_action_space
         # load() sets its keyword arguments on the model before this runs: check them as the constructor does
-        self.decoding = getattr(self, "decoding", "argmax")  # models saved before the option act on the argmax
-        check_choice("decoding", self.decoding, DECODINGS)
-        self.decoding_temperature = check_number(
-            "decoding_temperature", getattr(self, "decoding_temperature", 0.3), low=0.0, low_open=True
+        # (models saved before the option act on the argmax)
+        self.decoding, self.decoding_temperature = checked_decoding(
+            getattr(self, "decoding", "argmax"), getattr(self, "decoding_temperature", 0.3)
         )
         if self.decoding == "expectation" and self.action_grid is None:
             raise ValueError(
