@@ -338,7 +338,8 @@ def test_the_smooth_control_table_by_hand(tmp_path):
     """cartpole: the shipped entry's seeds 0-1 (seed 2 has no remedy run, so it is left out) end at task return 100
     and 100, SM 0.004 and 0.006; the remedy at 150 and 150, SM 0.001 and 0.003 (mean 0.002, bootstrap interval
     [0.001, 0.003]: the replicates of two values are 0.001, 0.002 or 0.003); SAC at 100 (3 seeds), SM 0.002. So SM
-    1.00x SAC's, task return +50 [+50, +50] against both."""
+    1.00x SAC's, task return +50 [+50, +50] against both. The rate-penalty agent at 120 and 80 (SM 0.002 and 0.004,
+    mean 0.003): SM 1.50x SAC's, task return +0 [-20, +20] against both (the replicates' means are 80, 100 or 120)."""
     import pandas as pd
 
     env = "dm_control/cartpole-swingup-v0"
@@ -362,6 +363,7 @@ def test_the_smooth_control_table_by_hand(tmp_path):
     )  # fmt: skip
     page = results_page()
     remedy = [run(page.SMOOTH_REMEDY, 0, 150.0, 0.001, 0.02), run(page.SMOOTH_REMEDY, 1, 150.0, 0.003, 0.02)]
+    remedy += [run(page.SMOOTH_RATE, 0, 120.0, 0.002, 0.05), run(page.SMOOTH_RATE, 1, 80.0, 0.004, 0.05)]
     early = [{**row, "step": 50_000, "task_return": -5.0} for row in remedy]
     pd.DataFrame(early + remedy).to_csv(tmp_path / "results.csv", index=False)
     model = f"runs/{page.SMOOTH_REMEDY}__dm_control-cartpole-swingup-v0__c0.1__seed{{}}/model.zip"
@@ -374,14 +376,19 @@ def test_the_smooth_control_table_by_hand(tmp_path):
     assert body[0] == "**cartpole-swingup**"
     assert body[4] == "| GQN, argmax (shipped entry) | 2 | 100 [100, 100] | 0.0050 [0.0040, 0.0060] | 0.200 [0.200, 0.200] |"
     assert body[5] == "| GQN, expectation 0.3 | 2 | 150 [150, 150] | 0.0020 [0.0010, 0.0030] | 0.020 [0.020, 0.020] |"
-    assert body[6] == (
+    assert body[6] == "| GQN, rate penalty 0.3 | 2 | 100 [80, 120] | 0.0030 [0.0020, 0.0040] | 0.050 [0.050, 0.050] |"
+    assert body[7] == (
         "| GQN, argmax, on the same final models | 2 | 140 [140, 140] | 0.0050 [0.0050, 0.0050] | 0.100 [0.100, 0.100] |"
     )
-    assert body[7].startswith("| GQN, expectation 0.3, on the same final models | 2 | 150 [150, 150] | 0.0010")
-    assert body[8] == "| SAC | 3 | 100 [100, 100] | 0.0020 [0.0020, 0.0020] | 0.010 [0.010, 0.010] |"
-    assert body[10] == (
-        "SM 1.00x SAC's (goal: at most 1.5x); task return minus the shipped entry's +50 [+50, +50], minus SAC's +50 "
-        "[+50, +50]."
+    assert body[8].startswith("| GQN, expectation 0.3, on the same final models | 2 | 150 [150, 150] | 0.0010")
+    assert body[9] == "| SAC | 3 | 100 [100, 100] | 0.0020 [0.0020, 0.0020] | 0.010 [0.010, 0.010] |"
+    assert body[11] == (
+        "Expectation 0.3: SM 1.00x SAC's (goal: at most 1.5x); task return minus the shipped entry's +50 [+50, +50], "
+        "minus SAC's +50 [+50, +50]."
+    )
+    assert body[13] == (
+        "Rate penalty 0.3: SM 1.50x SAC's (goal: at most 1.5x); task return minus the shipped entry's +0 [-20, +20], "
+        "minus SAC's +0 [-20, +20]."
     )
 
 
