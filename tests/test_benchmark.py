@@ -392,6 +392,31 @@ def test_the_smooth_control_table_by_hand(tmp_path):
     )
 
 
+def test_a_suite_table_by_hand(tmp_path):
+    """door-open at c = 0.5, final evaluations: GQN seeds 0-2 with success 1, 0, 1 (mean 0.67; the bootstrap replicates
+    of three values are all 0 with probability 1/27 > 2.5 %, all 1 with 8/27, so the interval is [0, 1]), return 300,
+    100, 200 (mean 200 [100, 300] the same way), task return 400, 200, 300, SM 0.01-0.03 (mean 0.02); SAC one seed
+    without a success flag. Earlier evaluations, agents left out of the table and agents without runs are not shown."""
+    import pandas as pd
+
+    def row(algo, seed, step, success, value, sm):
+        return {"algo": algo, "env": "sb3_gqn/metaworld-door-open-v3", "penalty": 0.5, "seed": seed, "step": step,
+                "return": value, "task_return": value + 100.0, "smoothness": sm, "success": success}  # fmt: skip
+
+    rows = [row("gqn-adaptive", seed, 50_000, success, value, sm)
+            for seed, success, value, sm in [(0, 1.0, 300.0, 0.01), (1, 0.0, 100.0, 0.02), (2, 1.0, 200.0, 0.03)]]  # fmt: skip
+    rows += [row("gqn-adaptive", 0, 25_000, 0.0, -1000.0, 1.0), row("sac", 0, 50_000, None, 50.0, 0.005)]
+    rows += [row("td3", 0, 50_000, 1.0, 999.0, 0.5)]
+    pd.DataFrame(rows).to_csv(tmp_path / "results.csv", index=False)
+    body = results_page().suite_block(tmp_path, {"gqn-adaptive": "GQN 9 -> 65", "decqn-9": "DecQN-9", "sac": "SAC"})
+    assert body.splitlines() == [
+        "| task | agent | seeds | success | return | task return | SM |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| door-open-v3 (c = 0.5) | GQN 9 -> 65 | 3 | 0.67 [0.00, 1.00] | 200 [100, 300] | 300 [200, 400] | 0.0200 |",
+        "| door-open-v3 (c = 0.5) | SAC | 1 | - | 50 | 150 | 0.0050 |",
+    ]
+
+
 @pytest.mark.parametrize(
     "module", ["sb3_gqn.experiments.runner", "sb3_gqn.experiments.reference_run", "sb3_gqn.experiments.report"]
 )

@@ -73,6 +73,17 @@ SMOOTH_DECODINGS = {"greedy": "argmax", "softmax 0.3": "expectation 0.3"}
 #: the goal: SM at most this multiple of SAC's
 SMOOTHNESS_GOAL = 1.5
 
+#: The paper's other benchmarks (docs/research/benchmarks.md): page name -> the runner's output folder and the agents
+#: shown (runner name: label); each page ``docs/results/<name>.md`` gets its table and the curves once the folder's
+#: ``results.csv`` exists
+SUITES = {
+    "metaworld": (
+        RESULTS / "metaworld_c0.5_50k",
+        {"gqn-adaptive": "GQN 9 -> 65", "gqn-adaptive+from2": "GQN 2 -> 9", "decqn-9": "DecQN-9", "sac": "SAC"},
+    ),
+    "myosuite": (RESULTS / "myosuite", {"gqn-adaptive": "GQN", "decqn-9": "DecQN-9", "sac": "SAC"}),
+}
+
 
 def shipped(table: pd.DataFrame) -> pd.DataFrame:
     """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs.
@@ -265,6 +276,33 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     return "\n".join(lines).strip()
 
 
+def suite_block(path: Path, agents: dict[str, str]) -> str:
+    """One benchmark suite's table (``<path>/results.csv``): per task, one row per agent of ``agents`` (runner name:
+    label) that ran it, with its seeds, the success rate (the task's own flag at the last step of each evaluation
+    episode, averaged), the final greedy return (penalized) and the task return, each mean [95 % bootstrap interval]
+    over seeds, and the mean SM, all at the final evaluation of each run."""
+    final = final_rows(load([path / "results.csv"]))
+    lines = [
+        "| task | agent | seeds | success | return | task return | SM |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for (env, penalty), runs in final.groupby(["env", "penalty"]):
+        task = str(env).split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
+        for agent, label in agents.items():
+            agent_runs = runs[runs["algo"] == agent]
+            if agent_runs.empty:
+                continue
+            success = agent_runs["success"].dropna().to_numpy() if "success" in agent_runs else np.empty(0)
+            cells = [
+                interval_cell(success, 2) if len(success) else "-",
+                interval_cell(agent_runs["return"].to_numpy(), 0),
+                interval_cell(agent_runs["task_return"].to_numpy(), 0),
+                f"{agent_runs['smoothness'].mean():.4f}",
+            ]
+            lines.append(f"| {task} (c = {penalty:g}) | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def replace_block(path: Path, name: str, body: str) -> None:
     """Rewrite the generated block ``name`` of the Markdown file ``path``."""
     text = path.read_text()
@@ -286,6 +324,10 @@ def run() -> int:
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
+    for name, (path, agents) in SUITES.items():
+        if (path / "results.csv").exists():
+            replace_block(RESULTS / f"{name}.md", name, suite_block(path, agents))
+            learning_curves(load([path / "results.csv"]), path)
     print(
         f"rebuilt {PAGE} (main, smooth-control), {README} (results, main-job, development) and the figures in "
         f"{RESULTS / 'main'}"
