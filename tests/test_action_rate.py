@@ -7,9 +7,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium import spaces
-from sb3_gqn.wrappers import ActionPenalty, ActionRatePenalty
 
 from sb3_gqn import GQN
+from sb3_gqn.common.wrappers import ActionPenalty, ActionRatePenalty
 from sb3_gqn.experiments.runner import main as benchmark
 from tests.envs import DecliningEnv
 
@@ -105,7 +105,7 @@ def test_the_comparison_runner_takes_it_as_a_variant(tmp_path):
     variants = tmp_path / "variants.yml"
     variants.write_text(
         "gqn-linear+rate:\n  algo: gqn\n  hyperparams: {growth: linear}\n"
-        "  add_env_wrappers:\n    - sb3_gqn.wrappers.ActionRatePenalty: {coef: 0.2}\n"
+        "  add_env_wrappers:\n    - sb3_gqn.common.wrappers.ActionRatePenalty: {coef: 0.2}\n"
     )
     out = tmp_path / "suite"
     argv = ["--variants", str(variants), "--algos", "gqn-linear+rate", "--envs", "Pendulum-v1", "--penalties", "0.1"]

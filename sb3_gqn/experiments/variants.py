@@ -13,7 +13,7 @@ over that algorithm's shipped entry::
       env_hyperparams:                 # optional: per env, set over the entry before ``hyperparams``
         dm_control/walker-walk-v0: {train_freq: 2}
       add_env_wrappers:                # optional: wrappers around the entry's (rl-zoo3's env_wrapper format), in
-        - sb3_gqn.wrappers.ActionRatePenalty: {coef: 0.1}   # training and evaluation
+        - sb3_gqn.common.wrappers.ActionRatePenalty: {coef: 0.1}   # training and evaluation
 """
 
 from __future__ import annotations
