@@ -85,6 +85,12 @@ SUITES = {
 }
 
 
+def task_name(env: str) -> str:
+    """The short name the tables print: ``dm_control/walker-walk-v0`` -> ``walker-walk``,
+    ``sb3_gqn/metaworld-reach-v3`` -> ``reach-v3``."""
+    return env.split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
+
+
 def shipped(table: pd.DataFrame) -> pd.DataFrame:
     """``table`` with the runs of SHIPPED's variants under the plain names in place of the earlier entries' runs.
 
@@ -124,7 +130,7 @@ def task_table(table: pd.DataFrame) -> str:
             mean, (low, high) = mean_interval(agent_runs["return"].to_numpy())
             spread = f"[{low:.0f}, {high:.0f}] ({len(agent_runs)} seeds)" if len(agent_runs) > 1 else "(1 seed)"
             cells.append(f"{mean:.0f} {spread}, SM {agent_runs['smoothness'].mean():.4f}")
-        lines.append(f"| {str(env).split('/')[-1].removesuffix('-v0')} | " + " | ".join(cells) + " |")
+        lines.append(f"| {task_name(str(env))} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -206,8 +212,7 @@ def development_block(path: Path = DEVELOPMENT) -> str:
             cell = f"{mean:.0f} [{low:.0f}, {high:.0f}] ({len(agent_runs)})" if len(agent_runs) > 1 else f"{mean:.0f} (1)"
             success = agent_runs["success"].dropna() if "success" in agent_runs else agent_runs["return"].iloc[:0]
             cells.append(cell + (f", success {success.mean():.2f}" if len(success) else ""))
-        task = str(env).split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
-        lines.append(f"| {task} | {penalty:g} | " + " | ".join(cells) + " |")
+        lines.append(f"| {task_name(str(env))} | {penalty:g} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -238,7 +243,7 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     lines = []
     for env, remedy_runs in remedies.groupby("env"):
         seeds = sorted(set(remedy_runs["seed"]))
-        task = str(env).split("/")[-1].removesuffix("-v0")
+        task = task_name(str(env))
         runs = final[final["env"] == env]
         rows = {"GQN, argmax (shipped entry)": runs[(runs["algo"] == "gqn-adaptive") & runs["seed"].isin(seeds)]}
         remedy_rows = {
@@ -276,18 +281,18 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     return "\n".join(lines).strip()
 
 
-def suite_block(path: Path, agents: dict[str, str]) -> str:
-    """One benchmark suite's table (``<path>/results.csv``): per task, one row per agent of ``agents`` (runner name:
+def suite_block(table: pd.DataFrame, agents: dict[str, str]) -> str:
+    """One benchmark suite's table (its ``results.csv`` as ``table``): per task, one row per agent of ``agents`` (runner name:
     label) that ran it, with its seeds, the success rate (the task's own flag at the last step of each evaluation
     episode, averaged), the final greedy return (penalized) and the task return, each mean [95 % bootstrap interval]
     over seeds, and the mean SM, all at the final evaluation of each run."""
-    final = final_rows(load([path / "results.csv"]))
+    final = final_rows(table)
     lines = [
         "| task | agent | seeds | success | return | task return | SM |",
         "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     for (env, penalty), runs in final.groupby(["env", "penalty"]):
-        task = str(env).split("/")[-1].removesuffix("-v0").removeprefix("metaworld-")
+        task = task_name(str(env))
         for agent, label in agents.items():
             agent_runs = runs[runs["algo"] == agent]
             if agent_runs.empty:
@@ -326,8 +331,9 @@ def run() -> int:
     replace_block(README, "development", development_block())
     for name, (path, agents) in SUITES.items():
         if (path / "results.csv").exists():
-            replace_block(RESULTS / f"{name}.md", name, suite_block(path, agents))
-            learning_curves(load([path / "results.csv"]), path)
+            suite = load([path / "results.csv"])
+            replace_block(RESULTS / f"{name}.md", name, suite_block(suite, agents))
+            learning_curves(suite, path)
     print(
         f"rebuilt {PAGE} (main, smooth-control), {README} (results, main-job, development) and the figures in "
         f"{RESULTS / 'main'}"
