@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from sb3_gqn.experiments.report import as_shipped, growth_checks, held_after_growth, main, report
+from sb3_gqn.experiments.report import as_shipped, growth_checks, held_after_growth, main, report, select
+from sb3_gqn.experiments.variants import load_variants
 
 
 def test_held_after_growth_hand_values():
@@ -36,7 +37,10 @@ def _row(algo, seed, step, value, events="", env="dm_control/cartpole-swingup-v0
     )
 
 
-def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
+def test_growth_checks_pair_each_event_with_the_evaluations_around_it(tmp_path):
+    # the cold-start agent below, defined here so that the test does not depend on another test loading it
+    (tmp_path / "variants.yml").write_text("gqn-cold:\n  algo: gqn\n  hyperparams: {growth_init: none}\n")
+    load_variants(tmp_path / "variants.yml")
     table = pd.DataFrame(
         [
             _row("gqn-adaptive", 0, 10_000, 400.0, "8000:3"),
@@ -68,8 +72,8 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it():
         150.0,
         False,  # 150 < 0.7 * 280 = 196 (300 -> 280 at the growth step would have held)
     )
-    # Without a warm start (the ablation's gqn-before) the untrained bins act at once: that evaluation is "after"
-    cold = linear.assign(algo="gqn-before")
+    # Without a warm start the untrained bins act at once: that evaluation is "after"
+    cold = linear.assign(algo="gqn-cold")
     [check] = growth_checks(cold)
     assert (check.before_step, check.before, check.after_step, check.after, check.held) == (
         10_000,
@@ -111,3 +115,42 @@ def test_as_shipped_puts_the_variant_runs_under_the_plain_names_on_that_task_onl
         "| walker-walk-v0 | gqn-adaptive | 0 | 100000 | 500 |" in out
         and "| walker-walk-v0 | gqn-adaptive | 0 | 100000 | 100 |" not in out
     )
+
+
+def _suite() -> pd.DataFrame:
+    reacher = "dm_control/reacher-easy-v0"
+    rows = [
+        _row(algo, seed, 50_000, 100.0 * seed + 10 * penalty_index, env=env) | {"penalty": (0.1, 0.5)[penalty_index]}
+        for algo in ("gqn-adaptive", "decqn-9")
+        for env in (reacher, "dm_control/cartpole-swingup-v0")
+        for penalty_index in (0, 1)
+        for seed in (0, 1, 2)
+    ]
+    return pd.DataFrame(rows)
+
+
+def test_select_keeps_the_rows_of_every_filter_at_once():
+    table = _suite()  # 2 algos x 2 envs x 2 penalties x 3 seeds = 24 runs
+    assert len(select(table)) == 24
+    chosen = select(table, envs=["dm_control/reacher-easy-v0"], penalties=[0.5], seeds=[0, 2])
+    assert sorted(zip(chosen["algo"], chosen["seed"], chosen["return"])) == [
+        ("decqn-9", 0, 10.0),
+        ("decqn-9", 2, 210.0),
+        ("gqn-adaptive", 0, 10.0),
+        ("gqn-adaptive", 2, 210.0),
+    ]
+    assert set(chosen["env"]) == {"dm_control/reacher-easy-v0"} and set(chosen["penalty"]) == {0.5}
+    assert len(select(table, algos=["decqn-9"], seeds=[1])) == 4  # 2 envs x 2 penalties
+
+
+def test_report_filters_the_runs_and_refuses_a_value_no_run_has(tmp_path, capsys):
+    path = tmp_path / "results.csv"
+    _suite().to_csv(path, index=False)
+    argv = [str(path), "--reps", "10", "--envs", "dm_control/reacher-easy-v0", "--penalties", "0.5", "--seeds", "2"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "| reacher-easy-v0 | gqn-adaptive | 2 | 50000 | 210 |" in out
+    assert "cartpole" not in out and "| reacher-easy-v0 | gqn-adaptive | 0 |" not in out
+    for flag, value in (("--seeds", "7"), ("--penalties", "0.3"), ("--envs", "Pendulum-v1"), ("--algos", "sac")):
+        assert main([str(path), flag, value]) == 2
+        assert f"{flag}: no runs of {value}" in capsys.readouterr().err

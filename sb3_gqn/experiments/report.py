@@ -5,6 +5,7 @@
     sb3-gqn report docs/results/*/results.csv --algos gqn-adaptive decqn-9 decqn-2   # only these
     sb3-gqn report ... --shipped dm_control/finger-spin-v0=+layernorm+1update   # finger's entries
     sb3-gqn report ... --compare gqn-adaptive:decqn-9 gqn-adaptive:sac   # how sure each comparison is
+    sb3-gqn report ... --envs dm_control/reacher-easy-v0 --penalties 0.5 --seeds 0 1 2   # only these runs
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
@@ -365,6 +366,20 @@ def plot_table(table: pd.DataFrame, out: Path) -> list[Path]:
         return plot_suite(combined, out)
 
 
+def select(
+    table: pd.DataFrame,
+    algos: Sequence[str] | None = None,
+    envs: Sequence[str] | None = None,
+    penalties: Sequence[float] | None = None,
+    seeds: Sequence[int] | None = None,
+) -> pd.DataFrame:
+    """The rows of these algorithms, envs, penalties and seeds; a filter left at None keeps every value."""
+    for column, values in (("algo", algos), ("env", envs), ("penalty", penalties), ("seed", seeds)):
+        if values:
+            table = table[table[column].isin(values)]
+    return table
+
+
 def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int:
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("tables", nargs="+", type=Path, help="results.csv files of the comparison runner")
@@ -374,6 +389,9 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     parser.add_argument("--plots", type=Path, help="also draw the suite's figures for the combined table into this folder")
     parser.add_argument("--reps", type=int, default=2000, help="bootstrap repetitions of the IQM intervals")
     parser.add_argument("--algos", nargs="+", help="only these algorithms (also for the IQM's per-task normalization)")
+    parser.add_argument("--envs", nargs="+", help="only the runs on these env ids")
+    parser.add_argument("--penalties", nargs="+", type=float, help="only the runs at these action-penalty coefficients")
+    parser.add_argument("--seeds", nargs="+", type=int, help="only the runs of these seeds")
     parser.add_argument(
         "--shipped",
         nargs="+",
@@ -406,8 +424,20 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     table = load(args.tables)
     for env, suffix in shipped:
         table = as_shipped(table, env, suffix)
-    if args.algos:
-        table = table[table["algo"].isin(args.algos)]
+    for flag, column, values in (
+        ("--algos", "algo", args.algos),
+        ("--envs", "env", args.envs),
+        ("--penalties", "penalty", args.penalties),
+        ("--seeds", "seed", args.seeds),
+    ):
+        absent = sorted(set(values or ()) - set(table[column]), key=str)
+        if absent:
+            print(f"{prog}: error: {flag}: no runs of {', '.join(map(str, absent))} in the tables", file=sys.stderr)
+            return 2
+    table = select(table, args.algos, args.envs, args.penalties, args.seeds)
+    if table.empty:
+        print(f"{prog}: error: no run matches all of the filters", file=sys.stderr)
+        return 2
     unknown = sorted({name for pair in pairs for name in pair} - set(table["algo"]))
     if unknown:
         print(f"{prog}: error: no runs of {', '.join(unknown)} to compare", file=sys.stderr)
