@@ -366,6 +366,10 @@ def plot_table(table: pd.DataFrame, out: Path) -> list[Path]:
         return plot_suite(combined, out)
 
 
+FILTERS = {"algos": "algo", "envs": "env", "penalties": "penalty", "seeds": "seed"}
+"""The report's run filters: the option (``--algos`` ...) and the ``results.csv`` column it selects on."""
+
+
 def select(
     table: pd.DataFrame,
     algos: Sequence[str] | None = None,
@@ -374,7 +378,7 @@ def select(
     seeds: Sequence[int] | None = None,
 ) -> pd.DataFrame:
     """The rows of these algorithms, envs, penalties and seeds; a filter left at None keeps every value."""
-    for column, values in (("algo", algos), ("env", envs), ("penalty", penalties), ("seed", seeds)):
+    for column, values in zip(FILTERS.values(), (algos, envs, penalties, seeds)):
         if values:
             table = table[table[column].isin(values)]
     return table
@@ -424,17 +428,13 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     table = load(args.tables)
     for env, suffix in shipped:
         table = as_shipped(table, env, suffix)
-    for flag, column, values in (
-        ("--algos", "algo", args.algos),
-        ("--envs", "env", args.envs),
-        ("--penalties", "penalty", args.penalties),
-        ("--seeds", "seed", args.seeds),
-    ):
-        absent = sorted(set(values or ()) - set(table[column]), key=str)
+    filters = {name: getattr(args, name) for name in FILTERS}
+    for name, values in filters.items():
+        absent = sorted(set(values or ()) - set(table[FILTERS[name]]), key=str)
         if absent:
-            print(f"{prog}: error: {flag}: no runs of {', '.join(map(str, absent))} in the tables", file=sys.stderr)
+            print(f"{prog}: error: --{name}: no runs of {', '.join(map(str, absent))} in the tables", file=sys.stderr)
             return 2
-    table = select(table, args.algos, args.envs, args.penalties, args.seeds)
+    table = select(table, **filters)
     if table.empty:
         print(f"{prog}: error: no run matches all of the filters", file=sys.stderr)
         return 2
