@@ -314,8 +314,8 @@ def test_the_development_table_reads_the_final_evaluations_and_success(tmp_path)
 
 
 def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
-    """The README's and the results page's generated tables are what docs/results/build.py makes of the committed
-    results.csv files: a table extended without `make results-page` fails here."""
+    """The README's, the results page's and the suite pages' generated tables are what docs/results/build.py makes of
+    the committed results.csv files: a table extended without `make results-page` fails here."""
     from sb3_gqn.experiments.variants import load_variants
 
     root = Path(__file__).parents[1]
@@ -332,6 +332,10 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     assert block(page.README, "results") == page.task_table(table)
     if len(page.smooth_control_runs()):
         assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
+    for name, (path, agents) in page.SUITES.items():
+        if (path / "results.csv").exists():
+            suite_table = page.load([path / "results.csv"])
+            assert block(page.RESULTS / f"{name}.md", name) == page.suite_block(suite_table, agents)
 
 
 def test_the_smooth_control_table_by_hand(tmp_path):
@@ -396,7 +400,9 @@ def test_a_suite_table_by_hand():
     """door-open at c = 0.5, final evaluations: GQN seeds 0-2 with success 1, 0, 1 (mean 0.67; the bootstrap replicates
     of three values are all 0 with probability 1/27 > 2.5 %, all 1 with 8/27, so the interval is [0, 1]), return 300,
     100, 200 (mean 200 [100, 300] the same way), task return 400, 200, 300, SM 0.01-0.03 (mean 0.02); SAC one seed
-    without a success flag. Earlier evaluations, agents left out of the table and agents without runs are not shown."""
+    without a success flag. The early column is the evaluation nearest 10k steps (a fifth of 50k): 10k for GQN's seeds
+    (returns -100, -200, -300: mean -200 [-300, -100]), 5k on SAC's tie between 5k and 15k (return 7); so its
+    header says "early return". Agents left out of the table and agents without runs are not shown."""
     import pandas as pd
 
     def row(algo, seed, step, success, value, sm):
@@ -405,15 +411,20 @@ def test_a_suite_table_by_hand():
 
     rows = [row("gqn-adaptive", seed, 50_000, success, value, sm)
             for seed, success, value, sm in [(0, 1.0, 300.0, 0.01), (1, 0.0, 100.0, 0.02), (2, 1.0, 200.0, 0.03)]]  # fmt: skip
-    rows += [row("gqn-adaptive", 0, 25_000, 0.0, -1000.0, 1.0), row("sac", 0, 50_000, None, 50.0, 0.005)]
+    rows += [row("gqn-adaptive", seed, step, 0.0, value, 1.0)
+             for seed in range(3) for step, value in [(10_000, -100.0 * (seed + 1)), (25_000, -1000.0)]]  # fmt: skip
+    rows += [row("sac", 0, step, None, value, 0.005) for step, value in [(5_000, 7.0), (15_000, 8.0), (50_000, 50.0)]]
     rows += [row("td3", 0, 50_000, 1.0, 999.0, 0.5)]
     body = results_page().suite_block(pd.DataFrame(rows), {"gqn-adaptive": "GQN 9 -> 65", "decqn-9": "DecQN-9", "sac": "SAC"})
     assert body.splitlines() == [
-        "| task | agent | seeds | success | return | task return | SM |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
-        "| door-open-v3 (c = 0.5) | GQN 9 -> 65 | 3 | 0.67 [0.00, 1.00] | 200 [100, 300] | 300 [200, 400] | 0.0200 |",
-        "| door-open-v3 (c = 0.5) | SAC | 1 | - | 50 | 150 | 0.0050 |",
+        "| task | agent | seeds | success | return | task return | SM | early return |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| door-open-v3 (c = 0.5) | GQN 9 -> 65 | 3 | 0.67 [0.00, 1.00] | 200 [100, 300] | 300 [200, 400] | 0.0200 "
+        "| -200 [-300, -100] |",
+        "| door-open-v3 (c = 0.5) | SAC | 1 | - | 50 | 150 | 0.0050 | 7 |",
     ]
+    header = results_page().suite_block(pd.DataFrame(rows), {"gqn-adaptive": "GQN 9 -> 65"}).splitlines()[0]
+    assert header.endswith("| SM | return at 10k |")  # every shown run's early evaluation is at 10k
 
 
 @pytest.mark.parametrize(

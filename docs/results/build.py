@@ -4,9 +4,9 @@ Reads the comparison suite's ``docs/results/<task>_c0.1_100k*/results.csv`` file
 entry to the plain agent names (:func:`shipped`), and rewrites the blocks between ``<!-- BEGIN generated: NAME -->`` and
 ``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``, and
 ``main-job`` from the committed reference runs in ``docs/results/reference_run/``, ``development`` from the
-development suite's runs in ``docs/results/development/``), and the
-figures in ``docs/results/main/``. The prose around the blocks is written by hand. Run from the repository root after
-extending a table with the comparison runner.
+development suite's runs in ``docs/results/development/``), the suite pages of :data:`SUITES` (``metaworld.md``,
+``myosuite.md``: their table and curves), and the figures in ``docs/results/main/``. The prose around the blocks is
+written by hand. Run from the repository root after extending a table with the comparison runner.
 """
 
 from __future__ import annotations
@@ -281,15 +281,32 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     return "\n".join(lines).strip()
 
 
+#: the suite tables' early column: the evaluation nearest this fraction of each run's budget (10k of 50k steps), where
+#: the paper expects growth from 2 bins to start poorly on velocity control
+EARLY_FRACTION = 0.2
+
+
+def early_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """The evaluation of every run nearest :data:`EARLY_FRACTION` of its last evaluation's step (the earlier one on a
+    tie)."""
+    keys = ["algo", "env", "penalty", "seed"]
+    target = table.groupby(keys)["step"].transform("max") * EARLY_FRACTION
+    ranked = table.assign(distance=(table["step"] - target).abs()).sort_values(["distance", "step"], kind="stable")
+    return ranked.drop_duplicates(keys).drop(columns="distance")
+
+
 def suite_block(table: pd.DataFrame, agents: dict[str, str]) -> str:
     """One benchmark suite's table (its ``results.csv`` as ``table``): per task, one row per agent of ``agents`` (runner name:
     label) that ran it, with its seeds, the success rate (the task's own flag at the last step of each evaluation
     episode, averaged), the final greedy return (penalized) and the task return, each mean [95 % bootstrap interval]
-    over seeds, and the mean SM, all at the final evaluation of each run."""
-    final = final_rows(table)
+    over seeds, the mean SM, all at the final evaluation of each run, and the return at :func:`early_rows`' evaluation
+    (its step in the header when every shown run has it at the same step)."""
+    final, early = final_rows(table), early_rows(table[table["algo"].isin(list(agents))])
+    early_steps = early["step"].unique()
+    early_label = f"return at {early_steps[0] / 1000:g}k" if len(early_steps) == 1 else "early return"
     lines = [
-        "| task | agent | seeds | success | return | task return | SM |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        f"| task | agent | seeds | success | return | task return | SM | {early_label} |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for (env, penalty), runs in final.groupby(["env", "penalty"]):
         task = task_name(str(env))
@@ -297,12 +314,14 @@ def suite_block(table: pd.DataFrame, agents: dict[str, str]) -> str:
             agent_runs = runs[runs["algo"] == agent]
             if agent_runs.empty:
                 continue
+            agent_early = early[(early["env"] == env) & (early["penalty"] == penalty) & (early["algo"] == agent)]
             success = agent_runs["success"].dropna().to_numpy() if "success" in agent_runs else np.empty(0)
             cells = [
                 interval_cell(success, 2) if len(success) else "-",
                 interval_cell(agent_runs["return"].to_numpy(), 0),
                 interval_cell(agent_runs["task_return"].to_numpy(), 0),
                 f"{agent_runs['smoothness'].mean():.4f}",
+                interval_cell(agent_early["return"].to_numpy(), 0),
             ]
             lines.append(f"| {task} (c = {penalty:g}) | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
