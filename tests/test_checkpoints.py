@@ -184,3 +184,38 @@ def test_replayable_resets_repeat_the_last_reset_for_both_kinds_of_generator(leg
     env.replay_next_reset(state)
     np.testing.assert_array_equal(env.reset()[0], first)
     assert isinstance(env.unwrapped.np_random, np.random.RandomState) == legacy
+
+
+HOLD = """
+import sys
+from pathlib import Path
+from sb3_gqn.experiments.runs import hold_run
+from sb3_gqn.experiments.variants import RunSpec
+with hold_run(RunSpec("gqn-adaptive", "Pendulum-v1", 0.1, 0, 400), Path(sys.argv[1])):
+    print("holding", flush=True)
+    sys.stdin.readline()
+"""
+
+
+def test_a_run_that_another_process_trains_is_refused_before_anything_is_written(tmp_path, capsys):
+    from sb3_gqn.experiments.runner import main
+    from sb3_gqn.experiments.runs import RunInProgressError
+
+    spec = RunSpec("gqn-adaptive", "Pendulum-v1", 0.1, 0, 400)
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD, str(tmp_path)], cwd=REPOSITORY, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert holder.stdout.readline().strip() == "holding"
+        with pytest.raises(RunInProgressError, match=f"{spec.name}: another process is training this run"):
+            run(spec, tmp_path, 200, 1, 1, checkpoint_freq=FREQ)
+        argv = ["--algos", "gqn-adaptive", "--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400"]
+        assert main([*argv, "--out", str(tmp_path), "--no-plots"]) == 2
+        assert f"another process is training ['{spec.name}']" in capsys.readouterr().err
+        assert not (tmp_path / "runs" / spec.name).exists()
+        assert not (tmp_path / "results.csv").exists()
+    finally:
+        holder.communicate("\n", timeout=60)
+    assert holder.returncode == 0
+    run(spec, tmp_path, 200, 1, 1)  # the lock goes with its holder
+    assert (tmp_path / "runs" / spec.name / "done.json").is_file()

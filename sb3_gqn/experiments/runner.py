@@ -30,7 +30,7 @@ os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoC
 
 from sb3_gqn.experiments.checkpoints import DEFAULT_CHECKPOINT_FREQ, KEEP
 from sb3_gqn.experiments.processes import run_in_processes
-from sb3_gqn.experiments.runs import collect, is_finished, progress_line, recorded_rows, run
+from sb3_gqn.experiments.runs import collect, is_finished, progress_line, recorded_rows, run, runs_in_progress
 from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, VARIANTS, RunSpec, load_variants, untrained_runs
 from sb3_gqn.zoo.hyperparams import penalized_env_ids
 
@@ -132,6 +132,10 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         for spec in specs:
             print(f"  {'done   ' if spec not in pending else 'pending'} {spec.name} ({spec.steps} steps)")
         return 0
+    held = runs_in_progress(pending, out)
+    if held:
+        print(f"{prog}: error: another process is training {held} into {out}: wait for it, or stop it first", file=sys.stderr)
+        return 2
     checkpointing = (args.checkpoint_freq or None, args.checkpoint_dir.resolve() if args.checkpoint_dir else None)
     jobs = max(1, min(args.jobs, len(pending) or 1))
     threads = args.threads or max(1, (os.cpu_count() or 1) // jobs)

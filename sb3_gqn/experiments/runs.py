@@ -13,12 +13,13 @@ import os
 import shutil
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from filelock import FileLock
+from filelock import FileLock, Timeout
 
 from sb3_gqn.common.evaluation import LearningCurveCallback
 from sb3_gqn.experiments.checkpoints import (
@@ -109,10 +110,71 @@ def run(
 
     ``report_progress`` (optional) is called with the run's env steps every 500 steps (the Ray runner
     forwards them to the driver; locally the driver reads ``runs/<run>/progress``).
+
+    :raises RunInProgressError: when another process trains ``spec`` into ``out`` (nothing is written then)
     """
-    run_dir = out / "runs" / spec.name
-    if (run_dir / "done.json").is_file():
+    if (out / "runs" / spec.name / "done.json").is_file():
         return spec.name
+    with hold_run(spec, out):
+        if (out / "runs" / spec.name / "done.json").is_file():  # the other process finished it
+            return spec.name
+        return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
+
+
+class RunInProgressError(RuntimeError):
+    """Another process trains this run into the same output folder."""
+
+
+@contextmanager
+def hold_run(spec: RunSpec, out: Path) -> Iterator[None]:
+    """Hold run ``spec``'s lock in ``out`` (``runs/<run>.lock``) while the block trains it.
+
+    Two processes that trained one run would both resume from the same checkpoints and both append to its curve.
+    The lock is an OS file lock: it is released when the holder exits, also when it is killed.
+
+    :raises RunInProgressError: at once, when another process holds the lock
+    """
+    (out / "runs").mkdir(parents=True, exist_ok=True)
+    lock = FileLock(out / "runs" / f"{spec.name}.lock", timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise RunInProgressError(
+            f"{spec.name}: another process is training this run into {out} (it holds {lock.lock_file}); "
+            "wait for it to finish, or stop it and start again: the run resumes from its newest checkpoint"
+        ) from None
+    try:
+        yield
+    finally:
+        lock.release()
+
+
+def runs_in_progress(specs: list[RunSpec], out: Path) -> list[str]:
+    """Names of the runs of ``specs`` that another process is training into ``out`` now."""
+    held = []
+    for spec in specs:
+        if not (out / "runs" / f"{spec.name}.lock").exists():
+            continue
+        try:
+            with hold_run(spec, out):
+                pass
+        except RunInProgressError:
+            held.append(spec.name)
+    return held
+
+
+def _train(
+    spec: RunSpec,
+    out: Path,
+    eval_freq: int,
+    eval_episodes: int,
+    threads: int,
+    report_progress: Callable[[int], None] | None,
+    checkpoint_freq: int | None,
+    checkpoint_dir: Path | None,
+) -> str:
+    """:func:`run`'s training, with the run's lock held."""
+    run_dir = out / "runs" / spec.name
     checkpoints = (checkpoint_dir / spec.name) if checkpoint_dir is not None else run_dir / "checkpoints"
     checkpoint = newest_whole_checkpoint(checkpoints) if checkpoint_freq else None
     if checkpoint is None:
