@@ -153,12 +153,37 @@ def test_success_is_a_third_panel_where_the_task_flags_it(tmp_path, monkeypatch)
     panels = {}
     real_subplots = plots.plt.subplots
 
+    drawn = []
+
     def counting_subplots(rows: int, columns: int, **kwargs):
         figure, axes = real_subplots(rows, columns, **kwargs)
         panels[len(panels)] = columns
+        drawn.append(axes)
         return figure, axes
 
     monkeypatch.setattr(plots.plt, "subplots", counting_subplots)
     paths = plots.learning_curves(results, tmp_path)
     assert [path.name for path in paths] == ["learning_curves_dmc_c0.5.png", "learning_curves_metaworld_c0.5.png"]
     assert list(panels.values()) == [2, 3]  # the task without the flag keeps two panels
+    # 95 % band: 1.96 * std / sqrt(2): step 100 1/6 -+ 0.327 = [-0.160, 0.493], step 200 2/3 -+ 0.653 = [0.013, 1.320]
+    band = drawn[1][2].collections[0].get_paths()[0].vertices[:, 1]
+    assert band.min() == 0.0 and band.max() == 1.0 and 0.49 < np.sort(np.unique(band))[-2] < 0.50
+    assert not drawn[1][2].texts  # someone succeeded
+
+
+def test_a_success_panel_where_no_agent_succeeded_says_so(tmp_path, monkeypatch):
+    rows = [
+        {"algo": algo, "env": "metaworld", "penalty": 0.5, "seed": 0, "step": step, "return": 1.0, "wall_time": 1.0,
+         "growth_events": "", "success": 0.0}
+        for algo in ("gqn", "sac")
+        for step in (100, 200)
+    ]  # fmt: skip
+    drawn = []
+    real_subplots = plots.plt.subplots
+    monkeypatch.setattr(
+        plots.plt, "subplots", lambda *args, **kwargs: drawn.append(real_subplots(*args, **kwargs)) or drawn[-1]
+    )
+    plots.learning_curves(pd.DataFrame(rows), tmp_path)
+    success_panel = drawn[0][1][2]
+    assert [text.get_text() for text in success_panel.texts] == ["no agent succeeded in any evaluation"]
+    assert [line.get_linewidth() for line in success_panel.lines] == [3.0, 1.5]  # the second stays visible on the first

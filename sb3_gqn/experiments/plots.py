@@ -116,7 +116,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
         # every second agent that grows writes its bin counts below its marks, so two agents' labels stay apart
         growing = [algo for algo, runs in task.groupby("algo") if growth_steps(runs)]
         most_seeds = 0
-        for algo, runs in task.groupby("algo"):
+        for order, (algo, runs) in enumerate(task.groupby("algo")):
             curve = mean_curve(runs)
             half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
             seeds = int(curve["count"].max())
@@ -129,9 +129,15 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             success = success_curve(runs)
             if with_success and success is not None:
                 spread = 1.96 * success["std"].fillna(0.0) / np.sqrt(success["count"])
-                axes[2].plot(success.index.to_numpy(), success["mean"], color=color)
+                # agents drawn later are drawn thinner, so curves that coincide (all at 0, say) stay visible
+                width = 1.5 + 1.5 * (task["algo"].nunique() - 1 - order)
+                axes[2].plot(success.index.to_numpy(), success["mean"], color=color, linewidth=width)
                 axes[2].fill_between(
-                    success.index.to_numpy(), success["mean"] - spread, success["mean"] + spread, alpha=0.2, color=color
+                    success.index.to_numpy(),
+                    (success["mean"] - spread).clip(0.0, 1.0),  # a rate's band stays within [0, 1]
+                    (success["mean"] + spread).clip(0.0, 1.0),
+                    alpha=0.2,
+                    color=color,
                 )
         if any(run_growth_events(runs) for _, runs in task.groupby(["algo", "seed"])):
             axes[0].errorbar([], [], xerr=[], fmt="v", color="grey", label="growth to n bins: median step, range over seeds")
@@ -142,6 +148,8 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             axes[2].set_xlabel("environment steps")
             axes[2].set_ylabel("success at the episode's final step")
             axes[2].set_ylim(-0.05, 1.05)
+            if not (task["success"].fillna(0.0) > 0).any():
+                axes[2].text(0.5, 0.5, "no agent succeeded in any evaluation", transform=axes[2].transAxes, ha="center")
         axes[0].legend(fontsize=8)
         spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
         figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
