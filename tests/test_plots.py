@@ -186,4 +186,4 @@ def test_a_success_panel_where_no_agent_succeeded_says_so(tmp_path, monkeypatch)
     plots.learning_curves(pd.DataFrame(rows), tmp_path)
     success_panel = drawn[0][1][2]
     assert [text.get_text() for text in success_panel.texts] == ["no agent succeeded in any evaluation"]
-    assert [line.get_linewidth() for line in success_panel.lines] == [3.0, 1.5]  # the second stays visible on the first
+    assert [line.get_linewidth() for line in success_panel.lines] == [2.5, 1.5]  # the second stays visible on the first

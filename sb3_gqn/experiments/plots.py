@@ -130,7 +130,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             if with_success and success is not None:
                 spread = 1.96 * success["std"].fillna(0.0) / np.sqrt(success["count"])
                 # agents drawn later are drawn thinner, so curves that coincide (all at 0, say) stay visible
-                width = 1.5 + 1.5 * (task["algo"].nunique() - 1 - order)
+                width = 1.5 + 1.0 * (task["algo"].nunique() - 1 - order)
                 axes[2].plot(success.index.to_numpy(), success["mean"], color=color, linewidth=width)
                 axes[2].fill_between(
                     success.index.to_numpy(),
