@@ -13,7 +13,9 @@ DOCUMENTS = [
     "README.md",
     "CHANGELOG.md",
     "docs/results/README.md",
+    "docs/results/metaworld.md",
     "docs/research/README.md",
+    "docs/research/benchmarks.md",
 ]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 CODE_BLOCK = re.compile(r"^```.*?^```", re.MULTILINE | re.DOTALL)
