@@ -113,10 +113,11 @@ def run(
 
     :raises RunInProgressError: when another process trains ``spec`` into ``out`` (nothing is written then)
     """
-    if (out / "runs" / spec.name / "done.json").is_file():
+    done = out / "runs" / spec.name / "done.json"
+    if done.is_file():
         return spec.name
     with hold_run(spec, out):
-        if (out / "runs" / spec.name / "done.json").is_file():  # the other process finished it
+        if done.is_file():  # the other process finished it
             return spec.name
         return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
 
