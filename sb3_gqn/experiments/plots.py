@@ -90,6 +90,11 @@ def success_curve(runs: pd.DataFrame) -> pd.DataFrame | None:
     )
 
 
+def _half_width(curve: pd.DataFrame) -> pd.Series:
+    """Half the width of a curve's 95 % normal interval of the mean over seeds (0 where one seed leaves no spread)."""
+    return 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
+
+
 def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None = None) -> list[Path]:
     """Return vs env steps and vs training wall time per (env, penalty): mean over seeds, 95 % CI band; the wall-time
     axis places each evaluation at the seeds' median training time (:func:`mean_curve`). Tasks that flag success
@@ -118,7 +123,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
         most_seeds = 0
         for order, (algo, runs) in enumerate(task.groupby("algo")):
             curve = mean_curve(runs)
-            half_width = 1.96 * curve["std"].fillna(0.0) / np.sqrt(curve["count"])
+            half_width = _half_width(curve)
             seeds = int(curve["count"].max())
             most_seeds = max(most_seeds, seeds)
             color = colors[str(algo)]
@@ -128,7 +133,7 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             _mark_growth_events(axes[0], runs, curve, color, below=algo in growing[1::2])
             success = success_curve(runs)
             if with_success and success is not None:
-                spread = 1.96 * success["std"].fillna(0.0) / np.sqrt(success["count"])
+                spread = _half_width(success)
                 # agents drawn later are drawn thinner, so curves that coincide (all at 0, say) stay visible
                 width = 1.5 + 1.0 * (task["algo"].nunique() - 1 - order)
                 axes[2].plot(success.index.to_numpy(), success["mean"], color=color, linewidth=width)
