@@ -14,6 +14,7 @@ DOCUMENTS = [
     "CHANGELOG.md",
     "docs/results/README.md",
     "docs/results/metaworld.md",
+    "docs/results/myosuite.md",
     "docs/research/README.md",
     "docs/research/benchmarks.md",
 ]
