@@ -171,10 +171,14 @@ def test_success_is_a_third_panel_where_the_task_flags_it(tmp_path, monkeypatch)
     assert not drawn[1][2].texts  # someone succeeded
 
 
-def test_a_success_panel_where_no_agent_succeeded_says_so(tmp_path, monkeypatch):
+@pytest.mark.parametrize(
+    ("success", "message"),
+    [(0.0, "no agent succeeded in any evaluation"), (1.0, "every agent succeeded in every evaluation")],
+)
+def test_a_success_panel_where_the_agents_coincide_at_a_bound_says_so(tmp_path, monkeypatch, success, message):
     rows = [
         {"algo": algo, "env": "metaworld", "penalty": 0.5, "seed": 0, "step": step, "return": 1.0, "wall_time": 1.0,
-         "growth_events": "", "success": 0.0}
+         "growth_events": "", "success": success}
         for algo in ("gqn", "sac")
         for step in (100, 200)
     ]  # fmt: skip
@@ -185,5 +189,5 @@ def test_a_success_panel_where_no_agent_succeeded_says_so(tmp_path, monkeypatch)
     )
     plots.learning_curves(pd.DataFrame(rows), tmp_path)
     success_panel = drawn[0][1][2]
-    assert [text.get_text() for text in success_panel.texts] == ["no agent succeeded in any evaluation"]
+    assert [text.get_text() for text in success_panel.texts] == [message]
     assert [line.get_linewidth() for line in success_panel.lines] == [2.5, 1.5]  # the second stays visible on the first

@@ -153,8 +153,11 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             axes[2].set_xlabel("environment steps")
             axes[2].set_ylabel("success at the episode's final step")
             axes[2].set_ylim(-0.05, 1.05)
-            if not (task["success"].fillna(0.0) > 0).any():
+            flagged = task["success"].dropna()
+            if not (flagged > 0).any():
                 axes[2].text(0.5, 0.5, "no agent succeeded in any evaluation", transform=axes[2].transAxes, ha="center")
+            elif (flagged == 1).all():
+                axes[2].text(0.5, 0.5, "every agent succeeded in every evaluation", transform=axes[2].transAxes, ha="center")
         axes[0].legend(fontsize=8)
         spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
         figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
