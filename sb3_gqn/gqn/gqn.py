@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from typing import Any, ClassVar, TypeVar
 
@@ -28,6 +29,7 @@ from sb3_gqn.common.masking import (
     epsilon_greedy,
     masked_expectation,
 )
+from sb3_gqn.common.precision import PRECISIONS, has_bf16_matrix_units, matmul_precision, resolve_precision
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.common.torsos import with_default_torso
 from sb3_gqn.common.wrappers import BinGrid
@@ -130,6 +132,12 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         between neighbouring bins. Training (exploration, growth's greedy episodes, the TD target) is unchanged
     :param decoding_temperature: the softmax temperature of ``decoding="expectation"``, in the utilities' units
         (towards 0 it is the greedy bin)
+    :param precision: the arithmetic of the training updates' matrix products (:mod:`sb3_gqn.common.precision`):
+        ``"fp32"``; ``"bf16"``, bfloat16 operands with float32 accumulation, master weights, optimizer state, targets,
+        loss and priorities (on bfloat16 kernels where the device has bfloat16 matrix units, elsewhere as the same
+        arithmetic on float32 kernels, no faster); ``"auto"``: ``"bf16"`` where the device has the units (CPUs with AMX
+        or AVX-512 BF16, CUDA compute capability 8.0 or later), else ``"fp32"``. Acting, saved weights and the exports
+        are float32 in every case
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -193,6 +201,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         growth_probation: int | None = None,
         decoding: str = "argmax",
         decoding_temperature: float = 0.3,
+        precision: str = "auto",
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
         policy_kwargs: dict[str, Any] | None = None,
@@ -223,6 +232,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         check_choice("growth", growth, GROWTH_SCHEDULES)
         check_choice("growth_init", growth_init, GROWTH_INITS)
         check_choice("exploration", exploration, EXPLORATION_MODES)
+        check_choice("precision", precision, PRECISIONS)
         decoding, decoding_temperature = checked_decoding(decoding, decoding_temperature)
         self.bins = bins
         self.bin_levels = bin_levels_from(bins)
@@ -264,6 +274,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         self.exploration = exploration
         self.decoding = decoding
         self.decoding_temperature = decoding_temperature
+        self.precision = precision
         self.max_grad_norm = max_grad_norm
         self.prioritized_replay = prioritized_replay
         self.priority_exponent = priority_exponent
@@ -311,6 +322,19 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             raise ValueError(
                 f"decoding='expectation' needs a Box action space (a continuous action between bin values); "
                 f"this env's is {env_action_space}: use decoding='argmax'"
+            )
+        # models saved before the option load with the class default, which resolves on the machine that loads them
+        self.precision = getattr(self, "precision", "auto")
+        check_choice("precision", self.precision, PRECISIONS)
+        #: the precision the updates run in: ``precision`` with ``"auto"`` resolved for this device
+        self.update_precision = resolve_precision(self.precision, self.device)
+        if self.precision == "bf16" and not has_bf16_matrix_units(self.device):
+            warnings.warn(
+                f"precision='bf16' on {self.device}, which has no bfloat16 matrix units: the updates round their "
+                "matrix products' operands to bfloat16 on float32 kernels (the same arithmetic as on bfloat16 hardware, "
+                "no faster). precision='auto' trains in float32 here.",
+                UserWarning,
+                stacklevel=2,
             )
         self.action_space = self.discrete_action_space
         # the policy keeps the averaged acting networks only when they are averaged (SB3 passes use_sde the same way)
@@ -487,6 +511,9 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
 
         critics = self.policy.critics
         online_parameters = self.policy.online_parameters()
+        # precision="bf16": the forward passes' (and so their backward passes') matrix products on bfloat16 operands;
+        # targets, loss, gradients and priorities stay float32 (sb3_gqn.common.precision)
+        precision = matmul_precision(self.update_precision, self.device) or contextlib.nullcontext()
         losses, q_values = [], []
         for _ in range(gradient_steps):
             replay_data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]
@@ -496,19 +523,19 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             weights = replay_data.weights if prioritized else None
             actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
             with th.no_grad():
+                with precision:
+                    next_online = [online(replay_data.next_observations) for online, _ in critics]
+                    next_target = [target_net(replay_data.next_observations) for _, target_net in critics]
                 # Eq. 3 with double Q (eq. 1): the online net picks a^j in A^g at s_{t+n}, the target net scores it
                 # (with n_critics > 1, DecQN's use_double_q: each critic's online net picks, the mean of the target
                 # nets scores)
                 targets = critic_ensemble_targets(
-                    [online(replay_data.next_observations) for online, _ in critics],
-                    [target_net(replay_data.next_observations) for _, target_net in critics],
-                    replay_data.rewards,
-                    replay_data.dones,
-                    discounts,
-                    active_bins_mask,
+                    next_online, next_target, replay_data.rewards, replay_data.dones, discounts, active_bins_mask
                 )
+            with precision:
+                utilities = [online(replay_data.observations) for online, _ in critics]
             # Eq. 2: Q(s_t, a_t) is the mean over dimensions of the chosen bins' utilities
-            currents = [decoupled_q_value(online(replay_data.observations), actions) for online, _ in critics]
+            currents = [decoupled_q_value(online_utilities, actions) for online_utilities in utilities]
             # Eq. 1: Huber loss on the TD error, weighted by (N P(i))^-beta under prioritized replay (several critics:
             # the losses add up, the new priorities are the mean |TD error|)
             loss, abs_td_errors = critic_ensemble_loss(currents, targets, weights)
@@ -605,7 +632,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         )
 
     def _excluded_save_params(self) -> list[str]:
-        excluded = ["q_net", "q_net_target", "_active_bin_indices", "_learning_bins_mask", "action_grid"]
+        excluded = ["q_net", "q_net_target", "_active_bin_indices", "_learning_bins_mask", "action_grid", "update_precision"]
         return [*super()._excluded_save_params(), *excluded]
 
     def _get_torch_save_params(self) -> tuple[list[str], list[str]]:
