@@ -50,6 +50,7 @@ AGENT_COLORS = {
     "decqn-2": "tab:red",
     "sac": "tab:purple",
     "td3": "tab:brown",
+    "sbx-sac": "tab:pink",
 }
 _OTHER_COLORS = ("tab:orange", "tab:cyan", "tab:pink", "tab:gray", "gold", "navy", "teal", "maroon")
 

@@ -199,8 +199,8 @@ def _train(
     from sb3_gqn.zoo.registration import register
 
     th.set_num_threads(threads)
-    register()
     zoo_algo, overrides = run_overrides(spec)
+    register([zoo_algo])
     wrappers = run_wrappers(spec)
     if checkpoint_freq:
         wrappers = [*wrappers, "sb3_gqn.experiments.checkpoints.ReplayableResets"]

@@ -7,7 +7,7 @@ A variants file (YAML) names further agents, each as the rl-zoo3 algorithm it tr
 over that algorithm's shipped entry::
 
     gqn-adaptive+twin:                 # the name the runner's --algos and results.csv use
-      algo: gqn                        # gqn, decqn, sac or td3: whose shipped entry it starts from
+      algo: gqn                        # gqn, decqn, sac, td3 or sbx_sac: whose shipped entry it starts from
       hyperparams: {growth: adaptive}  # set over the entry (rl-zoo3's format: policy_kwargs as source text)
       add_policy_kwargs: n_critics=2   # optional: keyword arguments added to the entry's policy_kwargs
       env_hyperparams:                 # optional: per env, set over the entry before ``hyperparams``
@@ -55,8 +55,10 @@ VARIANTS: dict[str, Variant] = {
     "decqn-9": Variant("decqn", {"bins": 9}),
     "sac": Variant("sac"),
     "td3": Variant("td3"),
+    # SBX's SAC (JAX, the sbx extra): SAC with the same entries, run faster
+    "sbx-sac": Variant("sbx_sac"),
 }
-ZOO_ALGOS = ("gqn", "decqn", "sac", "td3")
+ZOO_ALGOS = ("gqn", "decqn", "sac", "td3", "sbx_sac")
 
 
 def load_variants(path: str | Path) -> dict[str, Variant]:
@@ -185,8 +187,12 @@ def learning_starts(spec: RunSpec) -> int:
     from stable_baselines3 import SAC, TD3
 
     from sb3_gqn import GQN
+    from sb3_gqn.zoo.registration import SBX_ALGOS, sbx_algorithm
 
-    algorithm = {"gqn": GQN, "decqn": GQN, "sac": SAC, "td3": TD3}[zoo_algo]  # DecQN passes its kwargs to GQN
+    if zoo_algo in SBX_ALGOS:
+        algorithm: type[Any] = sbx_algorithm(zoo_algo)
+    else:  # DecQN passes its kwargs to GQN
+        algorithm = {"gqn": GQN, "decqn": GQN, "sac": SAC, "td3": TD3}[zoo_algo]
     return int(inspect.signature(algorithm).parameters["learning_starts"].default)
 
 

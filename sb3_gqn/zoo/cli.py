@@ -7,10 +7,11 @@ hyperparameter files as defaults (``sb3-gqn train|enjoy|record-video``).
     sb3-gqn enjoy --algo gqn --env dm_control/cartpole-swingup-v0 -f logs --no-render -n 5000
 
 Every rl-zoo3 flag works, plus ``--n-envs N`` (short for ``-params n_envs:N``). Without ``-conf`` the algorithms the
-project ships a file for (gqn, decqn, sac, td3) read ``sb3_gqn/zoo/hyperparams/<algo>.yml``; the others read
-rl-zoo3's own files. ``-optimize`` without ``--storage`` keeps the study in ``<log folder>/<algo>/optuna.db``
-(SQLite) under the name ``<algo>_<env>``. ``enjoy`` and ``record_video`` load the agent without a replay buffer
-(``buffer_size=1``). ``MUJOCO_GL`` defaults to ``disable`` for training (it renders nothing).
+project ships a file for (gqn, decqn, sac, td3) read ``sb3_gqn/zoo/hyperparams/<algo>.yml``, SBX's SAC (``--algo
+sbx_sac``, the ``sbx`` extra) reads SAC's; the others read rl-zoo3's own files. ``-optimize`` without ``--storage``
+keeps the study in ``<log folder>/<algo>/optuna.db`` (SQLite) under the name ``<algo>_<env>``. ``enjoy`` and
+``record_video`` load the agent without a replay buffer (``buffer_size=1``). ``MUJOCO_GL`` defaults to ``disable``
+for training (it renders nothing).
 """
 
 from __future__ import annotations
@@ -197,12 +198,12 @@ def _record_video() -> None:
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
     """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
     os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
-    register()
+    register([_option_value(sys.argv[1:] if argv is None else argv, "--algo")])
     return run_cli(_train, argv, prog=prog)
 
 
 def _replay(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
-    register()
+    register([_option_value(sys.argv[1:] if argv is None else argv, "--algo")])
     from rl_zoo3 import utils
 
     utils.ALGOS.update({name: loader_without_replay_memory(algo) for name, algo in ZOO_ALGOS.items()})

@@ -15,9 +15,14 @@ HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 ENV_KEYS = ("policy", "env_wrapper", "normalize", "n_envs", "frame_stack", "n_timesteps")
 
 
+#: Algorithms that read another algorithm's file: SBX's SAC is SB3's SAC (same defaults) run on JAX
+SHARED_HYPERPARAMS = {"sbx_sac": "sac"}
+
+
 def shipped_hyperparams(algo: str) -> Path | None:
-    """The project's hyperparameter file for ``algo`` (``gqn``, ``decqn``, ``sac``, ``td3``), if it ships one."""
-    path = HYPERPARAMS_DIR / f"{algo}.yml"
+    """The project's hyperparameter file for ``algo`` (``gqn``, ``decqn``, ``sac``, ``td3``; ``sbx_sac`` reads
+    ``sac``'s), if it ships one."""
+    path = HYPERPARAMS_DIR / f"{SHARED_HYPERPARAMS.get(algo, algo)}.yml"
     return path if path.is_file() else None
 
 

@@ -9,6 +9,8 @@ rl-zoo3's own algorithms.
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Iterable
 from typing import Any
 
 from sb3_gqn.common.envs import register_envs
@@ -17,16 +19,33 @@ from sb3_gqn.gqn.gqn import GQN
 
 #: The project's algorithms under their rl-zoo3 names
 ZOO_ALGOS: dict[str, type[GQN]] = {"gqn": GQN, "decqn": DecQN}
+#: SBX (Stable-Baselines-Jax, the ``sbx`` extra) algorithms under their rl-zoo3 names: ``(module, class)``. They are
+#: registered only when asked for (:func:`register`'s ``algos``): importing JAX costs seconds.
+SBX_ALGOS: dict[str, tuple[str, str]] = {"sbx_sac": ("sbx", "SAC")}
 
 
-def register() -> None:
+def sbx_algorithm(name: str) -> type[Any]:
+    """The SBX class of rl-zoo3 name ``name`` (:data:`SBX_ALGOS`).
+
+    :raises ImportError: naming the extra to install when SBX is not installed
+    """
+    module_name, class_name = SBX_ALGOS[name]
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as error:
+        raise ImportError(f"{name} trains SBX's {class_name}: install the sbx extra, pip install 'sb3-gqn[sbx]'") from error
+    return getattr(module, class_name)
+
+
+def register(algos: Iterable[str | None] = ()) -> None:
     """Put ``gqn`` and ``decqn`` into rl-zoo3's ``ALGOS``, Optuna samplers and converters, and register the suites'
-    env ids (idempotent)."""
+    env ids (idempotent). The SBX algorithms among ``algos`` (:data:`SBX_ALGOS`) are added to ``ALGOS`` too."""
     from rl_zoo3 import hyperparams_opt, utils
 
     from sb3_gqn.zoo.tuning import convert_gqn_params, sample_decqn_params, sample_gqn_params
 
     utils.ALGOS.update(ZOO_ALGOS)
+    utils.ALGOS.update({name: sbx_algorithm(name) for name in set(algos) if name in SBX_ALGOS})
     hyperparams_opt.HYPERPARAMS_SAMPLER.update({"gqn": sample_gqn_params, "decqn": sample_decqn_params})
     hyperparams_opt.HYPERPARAMS_CONVERTER.update({"gqn": convert_gqn_params, "decqn": convert_gqn_params})
     register_envs()
