@@ -1,6 +1,6 @@
 """Training and acting cost of GQN against the hardware's limits and the peers a user would pick, measured in one run.
 
-    python benchmarks/throughput.py                  # ~15 minutes on 2 cores
+    python benchmarks/throughput.py                  # ~15 minutes, one thread per agent (--threads)
     python benchmarks/throughput.py --rounds 3 --chunk 300   # quicker, noisier
     python benchmarks/throughput.py --device cuda    # the same on a GPU (peaks, updates, acting, training)
 
@@ -212,7 +212,11 @@ def main() -> None:
     parser.add_argument("--calls", type=int, default=2000, help="timed acting calls per path")
     parser.add_argument("--chunk", type=int, default=500, help="env steps per agent and round of the training comparison")
     parser.add_argument("--device", default="cpu", help="torch device of the networks: cpu or cuda")
+    parser.add_argument("--threads", type=int, default=1, help="CPU threads of torch and of JAX (SBX) alike")
     args = parser.parse_args()
+    th.set_num_threads(args.threads)
+    if args.threads == 1:  # before JAX is imported: XLA's CPU client otherwise spreads over every core
+        os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1")
     device = args.device
     if th.device(device).type == "cuda" and not th.cuda.is_available():
         parser.error(f"--device {device}: torch sees no CUDA device on this machine")
