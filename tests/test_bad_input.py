@@ -207,7 +207,7 @@ def test_the_cli_explains_unquoted_string_values(capsys, tmp_path):
 
 @pytest.mark.parametrize(
     "env_id, bins, penalty",
-    [("MountainCarContinuous-v0", [3, 9], True), ("Acrobot-v1", [2, 3], False), ("CartPole-v1", 2, False)],
+    [("MountainCarContinuous-v0", [3, 9], True), ("Acrobot-v1", 3, False), ("CartPole-v1", 2, False)],
 )
 def test_every_no_entry_template_trains_its_env(capsys, tmp_path, env_id, bins, penalty):
     argv = ["--algo", "gqn", "--env", env_id, "-f", str(tmp_path), "-n", "10"]

@@ -52,10 +52,28 @@ def test_bins_out_of_range(bins):
         GQN("MlpPolicy", DecliningEnv(), bins=bins)
 
 
-@pytest.mark.parametrize("bins", ["9", (2, 5, 9), 2.5, None])
-def test_bins_of_wrong_type(bins):
-    with pytest.raises(TypeError, match="bins"):
+@pytest.mark.parametrize(
+    ("bins", "message"),
+    [
+        ("9", r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got '9'"),
+        ((2, 5, 9), r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got \(2, 5, 9\)"),
+        (2.5, r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got 2\.5"),
+        (True, r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got True"),
+        ((2.0, 9), r"bins must be integers >= 2, got initial=2\.0 \(float\)"),
+        (("3", 9), r"bins must be integers >= 2, got initial='3' \(str\)"),
+        ((3, np.True_), r"bins must be integers >= 2, got final=np\.True_ \(bool\)"),
+    ],
+)
+def test_bins_of_wrong_type_are_a_value_error_naming_bins(bins, message):
+    with pytest.raises(ValueError, match=message):
         GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+@pytest.mark.parametrize("bins", [np.int64(9), (np.int64(3), np.int32(9)), [3, 9]])
+def test_numpy_integers_and_lists_are_bins_stored_as_python_ints(bins):
+    model = GQN("MlpPolicy", DecliningEnv(), bins=bins, policy_kwargs=dict(net_arch=[8]))
+    assert model.bins == (9 if np.ndim(bins) == 0 else (3, 9))
+    assert all(type(value) is int for value in np.atleast_1d(model.bins).tolist())
 
 
 @pytest.mark.parametrize("growth", ["exponential", "Linear", True, 1])
@@ -101,8 +119,19 @@ def test_load_with_other_bins_discretizes_to_saved_bins(tmp_path):
 def test_decqn_rejects_growth_and_pairs():
     with pytest.raises(ValueError, match="static"):
         DecQN("MlpPolicy", DecliningEnv(), growth="linear")
-    with pytest.raises(TypeError, match="single int"):
+    with pytest.raises(ValueError, match=r"bins must be a single int >= 2 for DecQN, got \(2, 9\); use GQN for"):
         DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9))
+
+
+@pytest.mark.parametrize("bins", ["9", 2.0, True, [9], 1])
+def test_decqn_bad_bins_are_a_value_error_naming_bins(bins):
+    with pytest.raises(ValueError, match="bins"):
+        DecQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+def test_decqn_takes_numpy_integers_as_gqn_does():
+    model = DecQN("MlpPolicy", DecliningEnv(), bins=np.int64(5), policy_kwargs=dict(net_arch=[8]))
+    assert model.bins == 5 and type(model.bins) is int and model.bin_levels == [5]
 
 
 def test_grow_backwards_or_past_the_end():
