@@ -88,8 +88,8 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
     For a ``Box`` action space: the growing bins and the action penalty. For ``Discrete(n)`` (and ``MultiDiscrete``
     with n choices everywhere): the bins GQN takes from such an env without ``bins``
     (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`: the env's own n choices, growing from 3 when n is a nested
-    level count 5, 9, 17, ..., static otherwise), and no penalty (it needs a ``Box``). ``action_space`` is read from the env when not given; an env that cannot be
-    made gets the ``Box`` entry.
+    level count 5, 9, 17, ..., static otherwise), and no penalty (it needs a ``Box``). ``action_space`` is read from
+    the env when not given; an env that cannot be made gets the ``Box`` entry.
     """
     from gymnasium import spaces
 
