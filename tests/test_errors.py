@@ -145,8 +145,22 @@ def test_grow_backwards_or_past_the_end():
 
 def test_load_with_bins_that_do_not_hold_the_saved_level(tmp_path):
     model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, policy_kwargs=dict(net_arch=[8]))
-    model.grow(3)
+    model.grow(1)  # 3 of 9 bins
     model.save(tmp_path / "model")
-    with pytest.raises(ValueError, match="Growth level 3 does not exist"):
+    with pytest.raises(ValueError, match=r"bins=\(5, 9\) does not fit .*model: the model acts on 3 bins per dimension"):
         GQN.load(tmp_path / "model", bins=(5, 9))
-    assert GQN.load(tmp_path / "model", bins=[2, 9]).active_bins == 9
+    loaded = GQN.load(tmp_path / "model", bins=[3, 9])  # level 1 of [2, 3, 5, 9] is level 0 of [3, 5, 9]
+    assert (loaded.growth_level, loaded.active_bins, loaded.bin_levels) == (0, 3, [3, 5, 9])
+
+
+def test_load_with_other_bins_keeps_the_active_bins_and_their_mask(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(3, 9), growth=None, policy_kwargs=dict(net_arch=[8]))
+    model.grow(2)  # level 2 of [3, 5, 9]: all 9 bins
+    model.save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model", bins=(2, 9))  # 9 bins are level 3 of [2, 3, 5, 9]
+    assert (loaded.growth_level, loaded.active_bins, loaded.deployed_bins) == (3, 9, 9)
+    assert loaded.policy.active_bins_mask.tolist() == [True] * 9
+    with pytest.raises(ValueError, match=r"bins=\(3, 17\) does not fit .*: its network holds 9 bins per action dimension"):
+        GQN.load(tmp_path / "model", bins=(3, 17))
+    with pytest.raises(ValueError, match=r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got '9'"):
+        GQN.load(tmp_path / "model", bins="9")
