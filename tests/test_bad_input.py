@@ -263,3 +263,23 @@ def test_another_algorithms_load_of_a_gqn_file_says_what_loads_it(tmp_path):
         SAC.load(tmp_path / "gqn")
     with pytest.raises(TypeError, match=r"A GQN or DecQN policy acts on bin indices .* got Box\("):
         DQN.load(tmp_path / "decqn")
+
+
+def test_a_truncated_or_damaged_model_file_is_a_value_error_naming_it(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "whole.zip")
+    whole = (tmp_path / "whole.zip").read_bytes()
+    with zipfile.ZipFile(tmp_path / "whole.zip") as archive:  # cut inside the last entry, a PyTorch zip of its own
+        last = archive.infolist()[-1]
+    cuts = {"empty": 0, "half": len(whole) // 2, "inside the last entry": last.header_offset + 100, "one byte": len(whole) - 1}
+    for name, cut in cuts.items():
+        (tmp_path / "cut.zip").write_bytes(whole[:cut])
+        with pytest.raises(ValueError, match=r"cut\.zip is not a whole model file"):
+            GQN.load(tmp_path / "cut.zip")
+    # a byte flipped inside the data entry: the same size, a failed CRC check
+    with zipfile.ZipFile(tmp_path / "whole.zip") as archive:
+        data = archive.getinfo("data")
+    flipped = bytearray(whole)
+    flipped[data.header_offset + 30 + len("data") + 10] ^= 0xFF
+    (tmp_path / "flipped.zip").write_bytes(bytes(flipped))
+    with pytest.raises(ValueError, match=r"flipped\.zip is not a whole model file \(its entry 'data' fails its CRC check"):
+        GQN.load(tmp_path / "flipped.zip")

@@ -41,6 +41,33 @@ def saved_data(path: SavedPath) -> dict[str, Any] | None:
         return None
 
 
+def check_model_file(path: SavedPath) -> None:
+    """Refuse a model file that is not whole, with a ``ValueError`` naming it, before SB3 reads it: a truncated zip
+    can still open (its last entry's own zip, a PyTorch file, ends it), without SB3's ``data`` entry (SB3: an
+    ``AssertionError``) or with entries that fail their CRC check. A path that does not exist is left to SB3."""
+    try:
+        if isinstance(path, io.BufferedIOBase):
+            position = path.tell()
+            try:
+                with zipfile.ZipFile(path) as archive:
+                    names, damaged = archive.namelist(), archive.testzip()
+            finally:
+                path.seek(position)
+        else:
+            file = pathlib.Path(path)
+            if not file.exists() and file.with_suffix(".zip").exists():
+                file = file.with_suffix(".zip")
+            if not file.is_file():
+                return
+            with zipfile.ZipFile(file) as archive:
+                names, damaged = archive.namelist(), archive.testzip()
+    except (zipfile.BadZipFile, EOFError, OSError) as error:
+        raise ValueError(f"{path} is not a whole model file (not a readable zip: {error}); it may be truncated") from None
+    if "data" not in names or damaged is not None:
+        why = f"its entry {damaged!r} fails its CRC check" if damaged is not None else "it has no 'data' entry"
+        raise ValueError(f"{path} is not a whole model file ({why}): it is truncated or damaged, or not saved by save()")
+
+
 def saved_algorithm(data: dict[str, Any]) -> str:
     """Which algorithm a model file holds, read from its policy class: ``"GQN"``, ``"DecQN"`` or e.g. ``"SAC"``."""
     policy = data.get("policy_class") or {}
@@ -125,6 +152,7 @@ class SavedFiles:
     def load(cls, path: SavedPath, *args: Any, **kwargs: Any) -> Any:
         """SB3's ``load``, after checking that the file holds a model of this class (GQN, or DecQN for
         ``DecQN.load``; a GQN file with static bins loads into either)."""
+        check_model_file(path)
         data = saved_data(path)
         if data is not None:
             holds = saved_algorithm(data)
