@@ -271,7 +271,7 @@ def test_a_truncated_or_damaged_model_file_is_a_value_error_naming_it(tmp_path):
     with zipfile.ZipFile(tmp_path / "whole.zip") as archive:  # cut inside the last entry, a PyTorch zip of its own
         last = archive.infolist()[-1]
     cuts = {"empty": 0, "half": len(whole) // 2, "inside the last entry": last.header_offset + 100, "one byte": len(whole) - 1}
-    for name, cut in cuts.items():
+    for cut in cuts.values():
         (tmp_path / "cut.zip").write_bytes(whole[:cut])
         with pytest.raises(ValueError, match=r"cut\.zip is not a whole model file"):
             GQN.load(tmp_path / "cut.zip")
