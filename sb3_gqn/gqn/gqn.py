@@ -244,6 +244,11 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         env = resolve_env(env)  # type: ignore[assignment]
         if env is not None:
             check_action_space(env.action_space)
+            if policy == "MlpPolicy" and isinstance(env.observation_space, spaces.Dict):
+                raise ValueError(
+                    f"policy='MlpPolicy' needs a flat observation, but this env's is a Dict ({list(env.observation_space)}"
+                    "): use 'MultiInputPolicy', or flatten it (sb3_gqn.common.envs.make_env(env_id) flattens)"
+                )
             if bins is None:  # the env's own choices for a Discrete/MultiDiscrete space (default_bins)
                 bins, grows = default_bins(env.action_space)
                 growth = growth if grows else None
