@@ -44,7 +44,8 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument(
         "--hyperparams",
         default=str(HYPERPARAMS_DIR / "gqn.yml"),
-        help="rl-zoo3-style file whose entry for --env supplies GQN arguments (train_freq, bins, ...)",
+        help="rl-zoo3-style file whose entry for --env supplies GQN's other arguments (train_freq, policy_kwargs, ...); "
+        "its bins and growth are ignored: --bins and --growth set them",
     )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")

@@ -195,9 +195,28 @@ def _record_video() -> None:
     runpy.run_module("rl_zoo3.record_video", run_name="__main__", alter_sys=False)
 
 
+TRAIN_HELP = """\
+sb3-gqn train: rl-zoo3's train with gqn and decqn registered; every rl-zoo3 option below works.
+
+Without -conf/--conf-file, gqn, decqn, sac and td3 read the project's files, sb3_gqn/zoo/hyperparams/<algo>.yml
+(the same envs, penalties and budgets for all four); an env without an entry fails with an entry printed to start
+from. GQN's and DecQN's own arguments go through -params as Python expressions, over the entry's:
+  -params bins:"(3, 9)" growth:"'linear'" growth_patience:3 decoding:"'expectation'" train_freq:2
+(bins, growth, growth_init, growth_eval_freq, growth_patience, growth_probation, exploration, acting_tau,
+decoding, decoding_temperature, prioritized_replay, n_steps, ...: help(sb3_gqn.GQN)). --n-envs N is short for
+-params n_envs:N; -optimize without --storage keeps its study in <log folder>/<algo>/optuna.db; -i <checkpoint.zip>
+continues with the checkpoint's replay buffer.
+
+rl-zoo3's options:
+"""
+
+
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
     """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
     os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
+    arguments = sys.argv[1:] if argv is None else list(argv)
+    if "-h" in arguments or "--help" in arguments:
+        print(TRAIN_HELP)
     register()
     return run_cli(_train, argv, prog=prog)
 

@@ -1,7 +1,7 @@
 """When to open the next, finer level of nested bins (paper section 4).
 
-* :func:`nested_bin_levels` lists the resolutions ``2 -> 3 -> 5 -> 9`` (each level doubles the
-  number of intervals between the action bounds).
+* :func:`nested_bin_levels` lists the resolutions, e.g. ``3 -> 5 -> 9`` (the default ``bins=(3, 9)``) or the
+  paper's ``2 -> 3 -> 5 -> 9`` (each level doubles the number of intervals between the action bounds).
 * ``growth="linear"``: :func:`linear_growth_level` opens level ``g`` (0-based, level 0 is
   active from the start) once ``g / (N + 1)`` of the total timesteps have passed, ``N`` being the
   number of levels.
