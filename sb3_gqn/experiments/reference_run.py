@@ -48,12 +48,29 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
         "its bins and growth are ignored: --bins and --growth set them",
     )
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--threads",
+        type=int,
+        default=1,
+        help="torch threads (default 1, as the committed runs in docs/results/reference_run/ were made: another count "
+        "sums in another order and the run follows another path)",
+    )
     parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")
     parser.add_argument("--eval-episodes", type=int, default=5, help="episodes per learning-curve evaluation")
     parser.add_argument("--final-episodes", type=int, default=10, help="episodes of the final evaluation")
     parser.add_argument("--out", default="results", help="output folder")
     parser.add_argument("--verbose", type=int, default=1)
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    for name in ("threads", "eval_freq", "eval_episodes", "final_episodes"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be >= 1, got {getattr(args, name)}")
+    if args.timesteps is not None and args.timesteps < 1:
+        parser.error(f"--timesteps must be >= 1, got {args.timesteps}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    if len(args.bins) > 2:
+        parser.error(f"--bins takes one int (static) or two (initial, final), got {args.bins}")
+    return args
 
 
 def load_hyperparams(path: str, env_id: str) -> dict[str, Any]:
@@ -183,7 +200,9 @@ def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
 
 def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn reference-run") -> int:
     """``sb3-gqn reference-run``: returns the exit code."""
-    train_and_evaluate(parse_args(argv, prog))
+    args = parse_args(argv, prog)
+    th.set_num_threads(args.threads)
+    train_and_evaluate(args)
     return 0
 
 
