@@ -114,7 +114,7 @@ def plot_learning_curve(
     import matplotlib.pyplot as plt
 
     steps = [row["step"] for row in rows]
-    figure, axis = plt.subplots(figsize=(6.4, 4.0))
+    figure, axis = plt.subplots(figsize=(6.4, 4.6))
     axis.plot(steps, [row["return_"] for row in rows], marker="o", label="return (penalized)")
     axis.plot(steps, [row["task_return"] for row in rows], marker=".", linestyle="--", label="task return")
     for step, bins in growth_events:
@@ -128,8 +128,8 @@ def plot_learning_curve(
     axis.set_ylabel("episode return (greedy)")
     axis.set_title(title, fontsize=9)
     axis.grid(alpha=0.3)
-    axis.legend(loc="upper left")
-    figure.tight_layout()
+    figure.legend(*axis.get_legend_handles_labels(), loc="lower center", ncol=2, fontsize=8)  # below, off the data
+    figure.tight_layout(rect=(0, 0.08, 1, 1))
     figure.savefig(path, dpi=120)
     plt.close(figure)
 
