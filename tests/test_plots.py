@@ -181,7 +181,10 @@ def test_every_figure_says_which_agents_it_leaves_out_and_keeps_its_legend_off_t
     monkeypatch.setattr(plots.plt, "close", figures.append)
     aggregate(results, tmp_path, reps=50)
     assert "Left out: sac (runs on 1 of 2 tasks)." in figure_texts(figures[-1])
-    curves_a, curves_b = plots.learning_curves(results, tmp_path)
+    aggregate(results[results["algo"] != "sac"], tmp_path, reps=50, left_out={"sac": "a baseline"})
+    assert "Left out: sac (a baseline)." in figure_texts(figures[-1])
+    figures.pop()
+    plots.learning_curves(results, tmp_path)  # task A, then task B
     assert "Left out: sac (no runs on this task)." in figure_texts(figures[-2])
     assert "Every agent of the table is drawn." in figure_texts(figures[-1])
     smoothness_radar(results, tmp_path)

@@ -243,17 +243,20 @@ def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, colo
         )  # fmt: skip
 
 
-def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None) -> Path:
+def aggregate(
+    table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None, left_out: dict[str, str] | None = None
+) -> Path:
     """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs, on at
-    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`)."""
+    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`).
+
+    The figure says which agents it leaves out: those of ``table`` without runs on every task, and ``left_out``, the
+    agents the caller took out of ``table`` before, each with the reason.
+    """
     scores, tasks = normalized_final_scores(table, max_runs)
     estimates, intervals = iqm_with_intervals(scores, reps)
-    covered = {
-        str(algo): len(set(zip(runs["env"], runs["penalty"]))) for algo, runs in final_rows(table).groupby("algo")
-    }
-    note = left_out_note(
-        list(covered), list(scores), {algo: f"runs on {count} of {len(tasks)} tasks" for algo, count in covered.items()}
-    )
+    covered = {str(algo): len(set(zip(runs["env"], runs["penalty"]))) for algo, runs in final_rows(table).groupby("algo")}
+    reasons = {algo: f"runs on {count} of {len(tasks)} tasks" for algo, count in covered.items()}
+    note = left_out_note([*covered, *(left_out or {})], list(scores), {**reasons, **(left_out or {})})
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
     figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
     colors = agent_colors(sorted(algos))
@@ -373,7 +376,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         figure.text(0.5, 0.01, textwrap.fill(caption, 140), ha="center", va="bottom", fontsize=7)
         figure.tight_layout(rect=(0, 0.09, 1, 1))
         path = out / f"smoothness_radar_{_slug(env)}.png"
-        figure.savefig(path, dpi=110)
+        figure.savefig(path, dpi=110, bbox_inches="tight")  # the legend beside the radar is inside the image
         plt.close(figure)
         paths.append(path)
     return paths
