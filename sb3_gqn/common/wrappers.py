@@ -113,11 +113,13 @@ def penalty_bounds(env: gym.Env, coef: float, wrapper: str, what: str) -> tuple[
     return checked, box.low.astype(np.float64).reshape(-1), box.high.astype(np.float64).reshape(-1)
 
 
-def check_finite_action(action: Any, wrapper: str) -> np.ndarray:
+def check_finite_action(action: Any, wrapper: str, size: int | None = None) -> np.ndarray:
     """``action`` as an array, if every entry is finite; a ``ValueError`` naming the action and the first bad index
     otherwise (a NaN action would make the penalty, the reward and, for :class:`ActionRatePenalty`, the following
     observations NaN)."""
     array = np.asarray(action, dtype=np.float64)
+    if size is not None and array.size != size:
+        raise ValueError(f"{wrapper}: the action {action!r} has {array.size} values, the action space {size}")
     if not np.isfinite(array).all():
         index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
         raise ValueError(
@@ -149,7 +151,7 @@ class ActionPenalty(gym.Wrapper):
         return self.coef * float(np.sum(normalized**2))
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
-        check_finite_action(action, "ActionPenalty")
+        check_finite_action(action, "ActionPenalty", self._low.size)
         obs, reward, terminated, truncated, info = self.env.step(action)
         penalty = self.penalty(action)
         info = dict(info)
@@ -217,7 +219,7 @@ class ActionRatePenalty(gym.Wrapper):
         return self._observation(observation), info
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
-        check_finite_action(action, "ActionRatePenalty")
+        check_finite_action(action, "ActionRatePenalty", self._low.size)
         observation, reward, terminated, truncated, info = self.env.step(action)
         normalized = np.clip(self.normalize(action), -1.0, 1.0)
         penalty = self.coef * float(np.sum((normalized - self.previous_action) ** 2))

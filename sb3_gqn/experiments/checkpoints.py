@@ -235,8 +235,8 @@ class RunCheckpointCallback(BaseCallback):
 
     def __init__(self, folder: Path, freq: int, curve: Path | None = None, extra: Any = None, verbose: int = 0):
         super().__init__(verbose)
-        if freq < 1:
-            raise ValueError(f"checkpoint frequency must be >= 1 env step, got {freq}")
+        if isinstance(freq, bool) or not isinstance(freq, (int, np.integer)) or freq < 1:
+            raise ValueError(f"checkpoint frequency must be an integer >= 1 env step, got {freq!r}")
         self.folder, self.freq, self.curve, self.extra = Path(folder), int(freq), curve, extra
         self.next_step = 0
         self.episode_ended = False

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import platform
 import sys
@@ -30,6 +31,7 @@ from stable_baselines3.common.monitor import Monitor
 from sb3_gqn import GQN, DecQN, __version__
 from sb3_gqn.common.envs import make_env
 from sb3_gqn.common.evaluation import LearningCurveCallback, evaluate
+from sb3_gqn.gqn.growth.schedules import checked_bins
 from sb3_gqn.zoo.hyperparams import HYPERPARAMS_DIR, constructor_arguments, read_entries
 
 
@@ -70,6 +72,12 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
         parser.error(f"--seed must be >= 0, got {args.seed}")
     if len(args.bins) > 2:
         parser.error(f"--bins takes one int (static) or two (initial, final), got {args.bins}")
+    try:
+        checked_bins(args.bins[0] if len(args.bins) == 1 else args.bins)
+    except ValueError as error:
+        parser.error(f"--bins: {error}")
+    if not math.isfinite(args.penalty) or args.penalty < 0:
+        parser.error(f"--penalty must be finite and >= 0, got {args.penalty}")
     return args
 
 

@@ -17,7 +17,13 @@ from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedul
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.common.arguments import check_choice, check_learning_arguments, check_number
+from sb3_gqn.common.arguments import (
+    check_choice,
+    check_learning_arguments,
+    check_model_arguments,
+    check_number,
+    check_total_timesteps,
+)
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
@@ -226,6 +232,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             max_grad_norm=max_grad_norm, priority_exponent=priority_exponent,
             importance_sampling_exponent=importance_sampling_exponent, stats_window_size=stats_window_size,
         )  # fmt: skip
+        check_model_arguments(policy_kwargs, replay_buffer_kwargs, seed, learning)
         adaptive_schedule = AdaptiveGrowth(
             eval_freq=growth_eval_freq,
             eval_episodes=growth_eval_episodes,
@@ -591,8 +598,10 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             user_callbacks = list(callback)
         elif isinstance(callback, BaseCallback):
             user_callbacks = [callback]
-        else:
+        elif callable(callback):
             user_callbacks = [ConvertCallback(callback)]
+        else:
+            raise ValueError(f"callback must be a BaseCallback, a list of them, a callable or None, got {callback!r}")
         callbacks: list[BaseCallback] = [GrowthCallback(env_was_reset=env_will_reset), *user_callbacks]
         total_timesteps, callback = super()._setup_learn(
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
@@ -625,7 +634,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         progress_bar: bool = False,
     ) -> SelfGQN:
         return super().learn(
-            total_timesteps=total_timesteps,
+            total_timesteps=check_total_timesteps(total_timesteps),
             callback=callback,
             log_interval=log_interval,
             tb_log_name=tb_log_name,

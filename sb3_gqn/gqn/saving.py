@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import pathlib
+import pickle
 import zipfile
 from typing import Any
 
@@ -178,7 +179,10 @@ class SavedFiles:
         """SB3's ``load_replay_buffer`` for files of :meth:`save_replay_buffer` (and SB3's own), refusing a buffer
         whose sampling (prioritized or uniform) is not the model's: the model would silently change how it learns."""
         current = self.replay_buffer
-        loaded = load_from_pkl(path, self.verbose)
+        try:
+            loaded = load_from_pkl(path, self.verbose)
+        except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, IndexError, ValueError) as error:
+            raise ValueError(f"{path} is not a replay-buffer file ({type(error).__name__}: {error})") from None
         kinds_differ = isinstance(current, PrioritizedSampling) != isinstance(loaded, PrioritizedSampling)
         if isinstance(loaded, ReplayBuffer) and current is not None and kinds_differ:
             have = "prioritized" if isinstance(loaded, PrioritizedSampling) else "uniform"
