@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 REPOSITORY = Path(__file__).resolve().parents[1]
@@ -107,3 +108,70 @@ def test_how_to_replicate_trains_what_it_lists(tmp_path, capsys):
     argv[out] = str(REPOSITORY / "docs" / "results" / "walker-walk_c0.1_100k")
     assert main(argv) == 0
     assert "6 runs, 6 already finished, 0 to train" in capsys.readouterr().out
+
+
+def raised(function) -> str:
+    try:
+        function()
+    except (ValueError, TypeError) as error:
+        return " ".join(str(error).split())
+    raise AssertionError("no error")
+
+
+def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
+    """Each row's quoted message is the start of what the code raises for that input."""
+    import gymnasium as gym
+    from stable_baselines3 import SAC
+
+    from sb3_gqn import GQN, DecQN
+    from sb3_gqn.common.wrappers import ActionRatePenalty
+    from tests.envs import DecliningEnv
+
+    tiny = dict(policy_kwargs=dict(net_arch=[8]), learning_starts=10, batch_size=8, buffer_size=1_000)
+    GQN("MlpPolicy", DecliningEnv(), **tiny).save(tmp_path / "model.zip")
+    (tmp_path / "cut.zip").write_bytes((tmp_path / "model.zip").read_bytes()[:100])
+    rate = ActionRatePenalty(gym.make("Pendulum-v1"))
+    rate.reset(seed=0)
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, **tiny)
+    cases = {
+        "bins must be an int >= 2 or an (initial, final) pair of ints, got '9'": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), bins="9"
+        ),
+        "bins must be integers >= 2, got initial=2.0 (float)": lambda: GQN("MlpPolicy", DecliningEnv(), bins=(2.0, 9)),
+        "bins=(2, 8) cannot be nested: doubling the intervals from 2 bins gives [2, 3, 5] then 9, never 8": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), bins=(2, 8)
+        ),
+        "bins must be a single int >= 2 for DecQN, got (2, 9); use GQN for (initial, final) pairs": lambda: DecQN(
+            "MlpPolicy", DecliningEnv(), bins=(2, 9)
+        ),
+        "bins=(3, 9) needs 9 choices per action dimension, but the env's action space Discrete(2) has 2: pass bins=2 "
+        "(or a pair ending in it)": lambda: GQN("MlpPolicy", "CartPole-v1", bins=(3, 9)),
+        "decoding_temperature must be a number in [1.175e-38, 3.403e+38], float32's positive normal range (the "
+        "utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN)": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), decoding_temperature=1e300
+        ),
+        "policy_kwargs['net_arch'] must be a list of layer sizes, integers >= 1, got [0]": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[0])
+        ),
+        "replay_buffer_kwargs['n_steps']=5 contradicts n_steps=3, which sets it: pass n_steps=5 instead": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(n_steps=5)
+        ),
+        "seed must be None or an integer in [0, 2**32 - 1], got -1": lambda: GQN("MlpPolicy", DecliningEnv(), seed=-1),
+        "total_timesteps must be an integer >= 0, got -5": lambda: model.learn(-5),
+        "callback must be a BaseCallback, a list of them, a callable or None, got 'x'": lambda: model.learn(1, callback="x"),
+        "level must be an integer index into bin_levels [2, 3, 5, 9] (or None), got 1.5": lambda: model.grow(1.5),
+        "A GQN or DecQN policy acts on bin indices (Discrete or MultiDiscrete), got Box(": lambda: SAC.load(
+            tmp_path / "model.zip"
+        ),
+        "is not a whole model file": lambda: GQN.load(tmp_path / "cut.zip"),
+        "is not a replay-buffer file (UnpicklingError": lambda: model.load_replay_buffer(tmp_path / "model.zip"),
+        "ActionRatePenalty: coef, the action rate penalty coefficient, must be a finite number >= 0, got '0.1'": lambda: (
+            ActionRatePenalty(gym.make("Pendulum-v1"), coef="0.1")
+        ),
+        "is not finite (index (0,): nan); the env was not stepped": lambda: rate.step(np.array([np.nan])),
+    }
+    table = flat("docs/modules/gqn.rst")
+    table = table[table.index(".. rubric:: Bad input") : table.index("Replay-buffer files")]
+    for message, function in cases.items():
+        assert message in raised(function), message
+        assert message in table, message
