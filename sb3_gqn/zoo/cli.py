@@ -180,6 +180,8 @@ def _train() -> None:
     from sb3_gqn.zoo import resume
 
     resume.install()  # -i <checkpoint> continues with that checkpoint's replay buffer
+    if "-h" in sys.argv[1:] or "--help" in sys.argv[1:]:  # what the project adds, before rl-zoo3's own help
+        print(TRAIN_HELP)
     sys.argv = [sys.argv[0], *default_train_arguments(sys.argv[1:])]
     zoo_train()
 
@@ -214,9 +216,6 @@ rl-zoo3's options:
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
     """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
     os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
-    arguments = sys.argv[1:] if argv is None else list(argv)
-    if "-h" in arguments or "--help" in arguments:
-        print(TRAIN_HELP)
     register()
     return run_cli(_train, argv, prog=prog)
 
