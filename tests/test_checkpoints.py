@@ -155,7 +155,7 @@ def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):
 
 
 def test_checkpoint_frequency_must_be_positive():
-    with pytest.raises(ValueError, match="checkpoint frequency must be >= 1"):
+    with pytest.raises(ValueError, match="checkpoint frequency must be an integer >= 1"):
         RunCheckpointCallback(Path("."), freq=0)
 
 
