@@ -88,8 +88,29 @@ def test_observations_it_cannot_extend_are_refused(space, message):
     env.observation_space = space
     with pytest.raises(ValueError, match=message):
         ActionRatePenalty(env, coef=0.1)
-    with pytest.raises(ValueError, match="finite and >= 0"):
+    with pytest.raises(ValueError, match="coef, the action rate penalty coefficient, must be a finite number >= 0"):
         ActionRatePenalty(ConstantEnv(), coef=-1.0)
+
+
+@pytest.mark.parametrize("wrapper", [ActionPenalty, ActionRatePenalty])
+@pytest.mark.parametrize("coef", ["0.1", None, True, np.array([0.1, 0.2]), float("inf"), -0.1])
+def test_a_coefficient_that_is_not_one_finite_number_is_a_value_error_naming_coef(wrapper, coef):
+    with pytest.raises(ValueError, match=rf"{wrapper.__name__}: coef, the .* must be a finite number >= 0, got "):
+        wrapper(ConstantEnv(), coef=coef)
+
+
+@pytest.mark.parametrize("wrapper", [ActionPenalty, ActionRatePenalty])
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_a_non_finite_action_is_refused_before_the_env_steps(wrapper, bad):
+    env = wrapper(ConstantEnv(), coef=0.1)
+    observation, _ = env.reset(seed=0)
+    with pytest.raises(ValueError, match=rf"{wrapper.__name__}: the action .* is not finite \(index \(1,\): {bad}\)"):
+        env.step(np.array([1.0, bad], dtype=np.float32))
+    # nothing was written: the next good action is penalized against the reset's previous action (the middle, 0)
+    observation, reward, *_ = env.step(np.array([2.0, 2.0], dtype=np.float32))
+    assert np.isfinite(observation).all()
+    # ActionPenalty: 0.1 * (1 ** 2 + 0 ** 2); ActionRatePenalty: 0.1 * ((1 - 0) ** 2 + (0 - 0) ** 2); both 1 - 0.1
+    assert reward == pytest.approx(0.9)
 
 
 def test_gqn_trains_on_it_and_acts_on_the_extended_observation():

@@ -11,7 +11,7 @@ import pytest
 import torch as th
 import yaml
 from gymnasium import spaces
-from stable_baselines3 import SAC
+from stable_baselines3 import DQN, SAC
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.env_util import make_vec_env
 
@@ -207,7 +207,7 @@ def test_the_cli_explains_unquoted_string_values(capsys, tmp_path):
 
 @pytest.mark.parametrize(
     "env_id, bins, penalty",
-    [("MountainCarContinuous-v0", [3, 9], True), ("Acrobot-v1", [2, 3], False), ("CartPole-v1", 2, False)],
+    [("MountainCarContinuous-v0", [3, 9], True), ("Acrobot-v1", 3, False), ("CartPole-v1", 2, False)],
 )
 def test_every_no_entry_template_trains_its_env(capsys, tmp_path, env_id, bins, penalty):
     argv = ["--algo", "gqn", "--env", env_id, "-f", str(tmp_path), "-n", "10"]
@@ -224,3 +224,62 @@ def test_every_no_entry_template_trains_its_env(capsys, tmp_path, env_id, bins, 
     assert code == 0
     saved = next(tmp_path.glob(f"gqn/{env_id}_*/{env_id}.zip"))
     assert zipfile.is_zipfile(saved)
+
+
+def test_another_algorithms_replay_buffer_is_refused_and_the_model_keeps_its_own(tmp_path):
+    sac = SAC("MlpPolicy", "Pendulum-v1", buffer_size=100, learning_starts=10)
+    sac.learn(20)
+    sac.save_replay_buffer(tmp_path / "sac_buffer")
+    for prioritized_replay in (False, True):
+        model = GQN("MlpPolicy", "Pendulum-v1", prioritized_replay=prioritized_replay, **TINY)
+        kept = model.replay_buffer
+        with pytest.raises(ValueError, match=r"sac_buffer(\.pkl)? holds a (uniform )?replay buffer"):
+            model.load_replay_buffer(tmp_path / "sac_buffer")
+        assert model.replay_buffer is kept
+    model = GQN("MlpPolicy", "Pendulum-v1", prioritized_replay=False, **TINY)
+    with pytest.raises(ValueError, match=r"actions in Box\(-2\.0, 2\.0, \(1,\), float32\) \(ReplayBuffer\), but this model "):
+        model.load_replay_buffer(tmp_path / "sac_buffer")
+
+
+def test_a_buffer_of_other_bins_or_another_n_step_return_is_refused(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), bins=(2, 5), prioritized_replay=False, **TINY).learn(20).save_replay_buffer(
+        tmp_path / "five"
+    )
+    model = GQN("MlpPolicy", DecliningEnv(), prioritized_replay=False, **TINY)
+    with pytest.raises(ValueError, match=r"actions in MultiDiscrete\(\[5 5\]\) .* bin indices in MultiDiscrete\(\[9 9\]\)"):
+        model.load_replay_buffer(tmp_path / "five")
+    GQN("MlpPolicy", DecliningEnv(), n_steps=1, prioritized_replay=False, **TINY).learn(20).save_replay_buffer(
+        tmp_path / "one_step"
+    )
+    with pytest.raises(ValueError, match=r"holds a 1-step replay buffer \(ReplayBuffer\), but this model learns from 3-step"):
+        model.load_replay_buffer(tmp_path / "one_step")
+
+
+def test_another_algorithms_load_of_a_gqn_file_says_what_loads_it(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "gqn")
+    DecQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "decqn")
+    message = r"got Box\(.*\): GQN and DecQN discretize a Box themselves, so a GQN or DecQN model file loads only with "
+    with pytest.raises(TypeError, match=message + r"GQN.load or DecQN.load, not with another algorithm's load"):
+        SAC.load(tmp_path / "gqn")
+    with pytest.raises(TypeError, match=r"A GQN or DecQN policy acts on bin indices .* got Box\("):
+        DQN.load(tmp_path / "decqn")
+
+
+def test_a_truncated_or_damaged_model_file_is_a_value_error_naming_it(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "whole.zip")
+    whole = (tmp_path / "whole.zip").read_bytes()
+    with zipfile.ZipFile(tmp_path / "whole.zip") as archive:  # cut inside the last entry, a PyTorch zip of its own
+        last = archive.infolist()[-1]
+    cuts = {"empty": 0, "half": len(whole) // 2, "inside the last entry": last.header_offset + 100, "one byte": len(whole) - 1}
+    for cut in cuts.values():
+        (tmp_path / "cut.zip").write_bytes(whole[:cut])
+        with pytest.raises(ValueError, match=r"cut\.zip is not a whole model file"):
+            GQN.load(tmp_path / "cut.zip")
+    # a byte flipped inside the data entry: the same size, a failed CRC check
+    with zipfile.ZipFile(tmp_path / "whole.zip") as archive:
+        data = archive.getinfo("data")
+    flipped = bytearray(whole)
+    flipped[data.header_offset + 30 + len("data") + 10] ^= 0xFF
+    (tmp_path / "flipped.zip").write_bytes(bytes(flipped))
+    with pytest.raises(ValueError, match=r"flipped\.zip is not a whole model file \(its entry 'data' fails its CRC check"):
+        GQN.load(tmp_path / "flipped.zip")

@@ -29,7 +29,8 @@ from sb3_gqn.experiments.variants import (
 )
 from sb3_gqn.zoo.hyperparams import shipped_entry
 
-RESEARCH_VARIANTS = Path(__file__).resolve().parents[1] / "docs" / "research" / "variants.yml"
+REPOSITORY = Path(__file__).resolve().parents[1]
+RESEARCH_VARIANTS = REPOSITORY / "docs" / "research" / "variants.yml"
 load_variants(RESEARCH_VARIANTS)  # the research record's agents, which the committed tables hold
 REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
 RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
@@ -327,6 +328,7 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
 
     table = page.comparison_table()
     assert block(page.README, "development") == page.development_block()
+    assert block(page.README, "main-job") == page.main_job_block()
     assert block(page.README, "results") == page.task_table(table)
     if len(page.smooth_control_runs()):
         assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
@@ -485,6 +487,7 @@ def test_two_critics_keep_the_entry_torso():
 
 def test_the_main_job_sentence_reads_the_committed_reference_runs(tmp_path):
     """Ranges over the seeds' final_evaluation.json: returns 700 and 812.4, level 9 reached by one of two seeds."""
+    page = results_page()
     for seed, value, events, speed in [
         (0, 700.0, [(9_000, 3), (20_500, 5), (40_000, 9)], 150.0),
         (1, 812.4, [(12_000, 3), (30_000, 5)], 171.6),
@@ -492,14 +495,37 @@ def test_the_main_job_sentence_reads_the_committed_reference_runs(tmp_path):
         run = tmp_path / f"run{seed}"
         run.mkdir()
         summary = {
-            "args": {"seed": seed},
+            "args": {**{key: value for key, value in page.MAIN_JOB_ARGS.items() if key != "threads"}, "seed": seed},
+            "machine": {"threads": 1},
             "final_evaluation": {"return_mean": value},
             "env_steps_per_second": speed,
             "growth_events": [{"step": step, "active_bins": bins} for step, bins in events],
         }
         (run / "final_evaluation.json").write_text(json.dumps(summary))
-    sentence = results_page().main_job_block(tmp_path)
-    assert "Over seeds 0, 1 of the committed runs" in sentence
+    sentence = page.main_job_block(tmp_path)
+    assert "Over seeds 0, 1 of the committed runs (`docs/results/reference_run/`, each made as `make results`" in sentence
     assert "the final greedy return is 700-812 (10 episodes each)" in sentence
     assert "the levels open to 3 at 9k-12k steps, to 5 at 20k-30k steps, to 9 at 40k-40k steps (1 of 2 seeds)" in sentence
     assert "training runs at 150-172 env steps/s" in sentence
+
+
+def test_the_main_job_sentence_refuses_runs_not_made_as_make_results_makes_them(tmp_path):
+    page = results_page()
+    (tmp_path / "run").mkdir()
+    summary = {"args": {**page.MAIN_JOB_ARGS, "seed": 0}, "machine": {"threads": 2}}
+    (tmp_path / "run" / "final_evaluation.json").write_text(json.dumps(summary))
+    with pytest.raises(SystemExit, match=r"was not made as make results makes the main job: threads=2 \(make results: 1\)"):
+        page.main_job_block(tmp_path)
+    assert all(not page.made_as_make_results(json.loads(path.read_text()))
+               for path in (REPOSITORY / "docs" / "results" / "reference_run").glob("*/final_evaluation.json"))  # fmt: skip
+
+
+def test_make_results_runs_the_main_job_as_the_sentence_assumes():
+    """The Makefile's reference-run line parses to :data:`MAIN_JOB_ARGS` (seed 0)."""
+    from sb3_gqn.experiments.reference_run import parse_args
+
+    makefile = (REPOSITORY / "Makefile").read_text()
+    line = next(line for line in makefile.splitlines() if "sb3-gqn reference-run" in line)
+    args = vars(parse_args(line.split("reference-run", 1)[1].split()))
+    expected = results_page().MAIN_JOB_ARGS
+    assert {key: args[key] for key in expected} == expected and args["seed"] == 0

@@ -2,6 +2,7 @@
 run that follows the uninterrupted one exactly."""
 
 import csv
+import hashlib
 import json
 import signal
 import subprocess
@@ -52,9 +53,26 @@ def kill_after_first_checkpoint(out: Path) -> None:
     assert not (out / "runs" / SPEC.name / "done.json").exists()
 
 
-def curve_steps(out: Path) -> list[int]:
-    with open(out / "runs" / SPEC.name / "curve.csv", newline="") as handle:
+def curve_steps(out: Path, spec: RunSpec = SPEC) -> list[int]:
+    with open(out / "runs" / spec.name / "curve.csv", newline="") as handle:
         return [int(row["step"]) for row in csv.DictReader(handle)]
+
+
+def kill_after_two_checkpoints(out: Path) -> tuple[int, int]:
+    """Start :data:`SPEC`'s run with a checkpoint every ``EVAL_FREQ`` steps in a process, SIGKILL it once two
+    checkpoints are whole, and return their steps (newest first)."""
+    code = RUN.replace(f"checkpoint_freq={FREQ}", f"checkpoint_freq={EVAL_FREQ}")
+    process = subprocess.Popen([sys.executable, "-c", code, str(out)], cwd=REPOSITORY, stdout=subprocess.DEVNULL)
+    folder = out / "runs" / SPEC.name / "checkpoints"
+    deadline = time.monotonic() + 300
+    while len([step for step in checkpoint_steps(folder) if is_whole(folder / f"step_{step}")]) < 2:
+        assert process.poll() is None, "the run ended before its second checkpoint"
+        assert time.monotonic() < deadline
+        time.sleep(0.1)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    newest, before = checkpoint_steps(folder)[:2]
+    return newest, before
 
 
 def final_parameters(out: Path) -> dict[str, th.Tensor]:
@@ -137,7 +155,7 @@ def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):
 
 
 def test_checkpoint_frequency_must_be_positive():
-    with pytest.raises(ValueError, match="checkpoint frequency must be >= 1"):
+    with pytest.raises(ValueError, match="checkpoint frequency must be an integer >= 1"):
         RunCheckpointCallback(Path("."), freq=0)
 
 
@@ -219,3 +237,50 @@ def test_a_run_that_another_process_trains_is_refused_before_anything_is_written
     assert holder.returncode == 0
     run(spec, tmp_path, 200, 1, 1)  # the lock goes with its holder
     assert (tmp_path / "runs" / spec.name / "done.json").is_file()
+
+
+def test_bytes_overwritten_without_a_change_of_size_are_found_by_the_checksum(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[8]), learning_starts=10, train_freq=1)
+    model.learn(20)
+    older = write_checkpoint(tmp_path, model, None, {})
+    model.learn(20, reset_num_timesteps=False)
+    newest = write_checkpoint(tmp_path, model, None, {})
+    record = json.loads((newest / "complete").read_text())
+    buffer = newest / "replay_buffer.pkl"
+    assert record["sha256"]["replay_buffer.pkl"] == hashlib.sha256(buffer.read_bytes()).hexdigest()
+    assert set(record["sha256"]) == set(record["sizes"]) == {"model.zip", "replay_buffer.pkl", "state.pkl"}
+    whole = buffer.read_bytes()
+    damaged = bytearray(whole)
+    damaged[len(whole) // 2 : len(whole) // 2 + 64] = bytes(64)  # 64 bytes overwritten, the size kept
+    buffer.write_bytes(bytes(damaged))
+    assert buffer.stat().st_size == len(whole) and not is_whole(newest)
+    with pytest.warns(UserWarning, match=f"{newest.name} is damaged"):
+        assert newest_whole_checkpoint(tmp_path) == older
+    buffer.write_bytes(whole)
+    assert is_whole(newest)
+
+
+def test_a_run_whose_newest_checkpoint_was_overwritten_resumes_from_the_one_before(tmp_path):
+    newest, before = kill_after_two_checkpoints(tmp_path)
+    buffer = tmp_path / "runs" / SPEC.name / "checkpoints" / f"step_{newest}" / "replay_buffer.pkl"
+    damaged = bytearray(buffer.read_bytes())
+    damaged[-200:-136] = bytes(64)  # 64 bytes overwritten, the size kept
+    buffer.write_bytes(bytes(damaged))
+    with pytest.warns(UserWarning, match=f"step_{newest} is damaged"):
+        run(SPEC, tmp_path, EVAL_FREQ, 2, 1, checkpoint_freq=EVAL_FREQ)
+    assert json.loads((tmp_path / "runs" / SPEC.name / "done.json").read_text())["resumed_from"] == [before]
+    assert curve_steps(tmp_path) == list(range(EVAL_FREQ, STEPS + 1, EVAL_FREQ))
+
+
+def test_a_checkpoint_that_does_not_load_is_marked_damaged_and_the_run_falls_back(tmp_path):
+    newest, before = kill_after_two_checkpoints(tmp_path)
+    checkpoint = tmp_path / "runs" / SPEC.name / "checkpoints" / f"step_{newest}"
+    # an earlier release's record (sizes only) is accepted unverified; the resume itself then finds the damage
+    (checkpoint / "replay_buffer.pkl").write_bytes(b"\0" * (checkpoint / "replay_buffer.pkl").stat().st_size)
+    record = json.loads((checkpoint / "complete").read_text())
+    (checkpoint / "complete").write_text(json.dumps({"step": newest, "sizes": record["sizes"]}))
+    assert is_whole(checkpoint)
+    with pytest.warns(UserWarning, match=f"resuming from .*step_{newest} failed"):
+        run(SPEC, tmp_path, EVAL_FREQ, 2, 1, checkpoint_freq=EVAL_FREQ)
+    assert json.loads((tmp_path / "runs" / SPEC.name / "done.json").read_text())["resumed_from"] == [before]
+    assert curve_steps(tmp_path) == list(range(EVAL_FREQ, STEPS + 1, EVAL_FREQ))

@@ -52,10 +52,28 @@ def test_bins_out_of_range(bins):
         GQN("MlpPolicy", DecliningEnv(), bins=bins)
 
 
-@pytest.mark.parametrize("bins", ["9", (2, 5, 9), 2.5, None])
-def test_bins_of_wrong_type(bins):
-    with pytest.raises(TypeError, match="bins"):
+@pytest.mark.parametrize(
+    ("bins", "message"),
+    [
+        ("9", r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got '9'"),
+        ((2, 5, 9), r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got \(2, 5, 9\)"),
+        (2.5, r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got 2\.5"),
+        (True, r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got True"),
+        ((2.0, 9), r"bins must be integers >= 2, got initial=2\.0 \(float\)"),
+        (("3", 9), r"bins must be integers >= 2, got initial='3' \(str\)"),
+        ((3, np.True_), r"bins must be integers >= 2, got final=np\.True_ \(bool\)"),
+    ],
+)
+def test_bins_of_wrong_type_are_a_value_error_naming_bins(bins, message):
+    with pytest.raises(ValueError, match=message):
         GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+@pytest.mark.parametrize("bins", [np.int64(9), (np.int64(3), np.int32(9)), [3, 9]])
+def test_numpy_integers_and_lists_are_bins_stored_as_python_ints(bins):
+    model = GQN("MlpPolicy", DecliningEnv(), bins=bins, policy_kwargs=dict(net_arch=[8]))
+    assert model.bins == (9 if np.ndim(bins) == 0 else (3, 9))
+    assert all(type(value) is int for value in np.atleast_1d(model.bins).tolist())
 
 
 @pytest.mark.parametrize("growth", ["exponential", "Linear", True, 1])
@@ -101,8 +119,19 @@ def test_load_with_other_bins_discretizes_to_saved_bins(tmp_path):
 def test_decqn_rejects_growth_and_pairs():
     with pytest.raises(ValueError, match="static"):
         DecQN("MlpPolicy", DecliningEnv(), growth="linear")
-    with pytest.raises(TypeError, match="single int"):
+    with pytest.raises(ValueError, match=r"bins must be a single int >= 2 for DecQN, got \(2, 9\); use GQN for"):
         DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9))
+
+
+@pytest.mark.parametrize("bins", ["9", 2.0, True, [9], 1])
+def test_decqn_bad_bins_are_a_value_error_naming_bins(bins):
+    with pytest.raises(ValueError, match="bins"):
+        DecQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+def test_decqn_takes_numpy_integers_as_gqn_does():
+    model = DecQN("MlpPolicy", DecliningEnv(), bins=np.int64(5), policy_kwargs=dict(net_arch=[8]))
+    assert model.bins == 5 and type(model.bins) is int and model.bin_levels == [5]
 
 
 def test_grow_backwards_or_past_the_end():
@@ -116,8 +145,22 @@ def test_grow_backwards_or_past_the_end():
 
 def test_load_with_bins_that_do_not_hold_the_saved_level(tmp_path):
     model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, policy_kwargs=dict(net_arch=[8]))
-    model.grow(3)
+    model.grow(1)  # 3 of 9 bins
     model.save(tmp_path / "model")
-    with pytest.raises(ValueError, match="Growth level 3 does not exist"):
+    with pytest.raises(ValueError, match=r"bins=\(5, 9\) does not fit .*model: the model acts on 3 bins per dimension"):
         GQN.load(tmp_path / "model", bins=(5, 9))
-    assert GQN.load(tmp_path / "model", bins=[2, 9]).active_bins == 9
+    loaded = GQN.load(tmp_path / "model", bins=[3, 9])  # level 1 of [2, 3, 5, 9] is level 0 of [3, 5, 9]
+    assert (loaded.growth_level, loaded.active_bins, loaded.bin_levels) == (0, 3, [3, 5, 9])
+
+
+def test_load_with_other_bins_keeps_the_active_bins_and_their_mask(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), bins=(3, 9), growth=None, policy_kwargs=dict(net_arch=[8]))
+    model.grow(2)  # level 2 of [3, 5, 9]: all 9 bins
+    model.save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model", bins=(2, 9))  # 9 bins are level 3 of [2, 3, 5, 9]
+    assert (loaded.growth_level, loaded.active_bins, loaded.deployed_bins) == (3, 9, 9)
+    assert loaded.policy.active_bins_mask.tolist() == [True] * 9
+    with pytest.raises(ValueError, match=r"bins=\(3, 17\) does not fit .*: its network holds 9 bins per action dimension"):
+        GQN.load(tmp_path / "model", bins=(3, 17))
+    with pytest.raises(ValueError, match=r"bins must be an int >= 2 or an \(initial, final\) pair of ints, got '9'"):
+        GQN.load(tmp_path / "model", bins="9")

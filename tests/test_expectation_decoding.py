@@ -10,7 +10,7 @@ import pytest
 import torch as th
 
 from sb3_gqn import GQN
-from sb3_gqn.common.masking import masked_expectation
+from sb3_gqn.common.masking import TEMPERATURE_RANGE, masked_expectation
 from sb3_gqn.export import export_onnx, export_torchscript
 from tests.test_export import observations, run_onnx, run_torchscript
 
@@ -77,16 +77,21 @@ def test_learn_save_and_load_keep_the_decoding(tmp_path):
     np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], model.predict(batch, deterministic=True)[0])
 
 
+RANGE = r"decoding_temperature must be a number in \[1\.175e-38, 3\.403e\+38\], float32's positive normal range"
+
+
 @pytest.mark.parametrize(
     "kwargs, message",
     [
         (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation'\), got 'median'"),
-        (
-            dict(decoding="expectation", decoding_temperature=0.0),
-            r"decoding_temperature must be a finite number in \(0, inf\)",
-        ),
-        (dict(decoding_temperature=float("nan")), r"decoding_temperature must be a finite number in \(0, inf\), got nan"),
-        (dict(decoding_temperature=True), r"decoding_temperature must be a finite number in \(0, inf\), got True"),
+        (dict(decoding="expectation", decoding_temperature=0.0), RANGE + r".*got 0\.0"),
+        (dict(decoding_temperature=float("nan")), RANGE + ".*got nan"),
+        (dict(decoding_temperature=True), RANGE + ".*got True"),
+        # float32 has no such temperature: 1e-300 is 0 there and 1e300 inf, and the softmax of either was NaN
+        (dict(decoding="expectation", decoding_temperature=1e-300), RANGE + r".*got 1e-300"),
+        (dict(decoding="expectation", decoding_temperature=1e300), RANGE + r".*got 1e\+300"),
+        (dict(decoding="expectation", decoding_temperature=1e-39), RANGE + r".*got 1e-39"),  # subnormal in float32
+        (dict(decoding="expectation", decoding_temperature="0.3"), RANGE + r".*got '0\.3'"),
     ],
 )
 def test_bad_decoding_arguments_are_refused(kwargs, message, tmp_path):
@@ -114,3 +119,43 @@ def test_a_trained_argmax_model_switches_to_the_expectation_at_load(tmp_path):
 def test_the_expectation_needs_a_box_action_space():
     with pytest.raises(ValueError, match="decoding='expectation' needs a Box action space"):
         GQN("MlpPolicy", gym.make("CartPole-v1"), bins=2, growth=None, decoding="expectation")
+
+
+def test_extreme_utilities_and_temperatures_give_no_nan():
+    # the greedy bin's scaled utility is exactly 0: 1e30 / 1e-30 used to overflow to inf (and inf - inf is NaN)
+    utilities = th.tensor([[[1e30, -1e30, 0.0, 5e37]]])
+    mask = th.tensor([True, True, True, False])
+    values = th.tensor([[-1.0, 0.0, 1.0, 7.0]])
+    assert masked_expectation(utilities, mask, values, 1e-30).item() == -1.0  # the greedy active bin
+    low, high = TEMPERATURE_RANGE
+    assert masked_expectation(utilities, mask, values, low).item() == -1.0
+    # at float32's largest temperature every active utility gap scales to 0 or -0: the active bins' mean, (-1+0+1)/3
+    assert masked_expectation(th.tensor([[[1.0, 2.0, 3.0, 4.0]]]), mask, values, high).item() == 0.0
+    assert low == np.finfo(np.float32).tiny and high == np.finfo(np.float32).max
+
+
+@pytest.mark.parametrize("temperature", [1e-300, 1e300])
+def test_a_temperature_float32_cannot_hold_is_refused_and_the_range_ends_act_finitely(temperature, tmp_path):
+    """``predict``, TorchScript and ONNX never answer a finite observation with NaN: a temperature outside float32's
+    range is refused (constructor and load), and its nearest end of the range acts: the greedy bin's value at the low
+    end, the mean of the active bins' values at the high end."""
+    with pytest.raises(ValueError, match=RANGE):
+        pendulum_model(decoding="expectation", decoding_temperature=temperature)
+    pendulum_model().save(tmp_path / "model")
+    with pytest.raises(ValueError, match=RANGE):
+        GQN.load(tmp_path / "model", decoding="expectation", decoding_temperature=temperature)
+    end = TEMPERATURE_RANGE[0] if temperature < 1 else TEMPERATURE_RANGE[1]
+    model = pendulum_model(decoding="expectation", decoding_temperature=end)
+    batch = observations(model.observation_space, count=64)
+    if temperature < 1:  # the greedy bin's torque
+        expected = pendulum_model().predict(batch, deterministic=True)[0]
+    else:  # 5 active bins of Pendulum's [-2, 2]: torques -2, -1, 0, 1, 2, mean 0
+        expected = np.zeros((64, 1), dtype=np.float32)
+    actions = {
+        "predict": model.predict(batch, deterministic=True)[0],
+        "torchscript": run_torchscript(export_torchscript(model, tmp_path / "policy.pt"), batch),
+        "onnx": run_onnx(export_onnx(model, tmp_path / "policy.onnx"), batch),
+    }
+    for name, action in actions.items():
+        assert np.isfinite(action).all(), name
+        np.testing.assert_allclose(action, expected, atol=1e-6, err_msg=name)

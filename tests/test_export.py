@@ -197,6 +197,29 @@ def test_readme_inference_script_runs_without_sb3_or_sb3_gqn(tmp_path):
         np.testing.assert_allclose(np.array(line.split(":")[1].split(), dtype=np.float32), expected, rtol=0, atol=0)
 
 
+def test_the_inference_script_casts_a_float64_observation_and_prints_its_usage(tmp_path):
+    env = gym.make("Pendulum-v1")
+    model = GQN("MlpPolicy", env, policy_kwargs=dict(net_arch=[16]), seed=0)
+    export_onnx(model, tmp_path / "policy.onnx")
+    export_torchscript(model, tmp_path / "policy.pt")
+    observation = env.reset(seed=0)[0].astype(np.float64)  # np.save of a Python list or a float64 array
+    np.save(tmp_path / "observation.npy", observation)
+    script = [sys.executable, str(REPOSITORY / "examples" / "run_exported_policy.py")]
+    result = subprocess.run(
+        [*script, "policy.onnx", "policy.pt", "observation.npy"], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert result.returncode == 0, result.stderr
+    expected, _ = model.predict(observation.astype(np.float32), deterministic=True)
+    for line in result.stdout.splitlines():
+        np.testing.assert_allclose(np.array(line.split(":")[1].split(), dtype=np.float32), expected, rtol=0, atol=0)
+    one = subprocess.run([*script, "policy.onnx"], cwd=tmp_path, capture_output=True, text=True)
+    assert one.returncode == 1 and one.stderr.startswith("usage: python examples/run_exported_policy.py policy.onnx")
+    assert "expected 2 or 3 arguments, got 1" in one.stderr
+    np.save(tmp_path / "wrong.npy", np.zeros(4))
+    wrong = subprocess.run([*script, "policy.onnx", "policy.pt", "wrong.npy"], cwd=tmp_path, capture_output=True, text=True)
+    assert wrong.returncode == 1 and "wrong.npy holds shape (4,), policy.onnx takes (3,)" in wrong.stderr
+
+
 def test_the_onnx_file_alone_deploys_from_a_fresh_folder(tmp_path):
     """One self-contained file: no ``policy.onnx.data`` beside it, and a copy alone in another folder runs."""
     model = GQN("MlpPolicy", "Pendulum-v1", seed=0)  # DecQN's 512 x 512 torso: about 1.1 MB of weights

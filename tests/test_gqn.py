@@ -460,9 +460,9 @@ def test_two_critics_act_on_their_maximum_learn_both_grow_both_and_round_trip(tm
     loaded.learn(100, reset_num_timesteps=False)
 
 
-@pytest.mark.parametrize("n_critics", [0, -1, 1.5])
+@pytest.mark.parametrize("n_critics", [0, -1, 1.5, True])
 def test_n_critics_must_be_a_positive_integer(n_critics):
-    with pytest.raises(ValueError, match="n_critics must be a positive integer"):
+    with pytest.raises(ValueError, match=r"policy_kwargs\['n_critics'\] must be an integer >= 1"):
         GQN("MlpPolicy", DecliningEnv(), policy_kwargs=dict(n_critics=n_critics))
 
 

@@ -31,9 +31,10 @@ def test_nested_bin_levels_rejects_pairs_that_cannot_nest(initial, final):
         nested_bin_levels(initial, final)
 
 
-def test_nested_bin_levels_rejects_non_integers():
-    with pytest.raises(TypeError):
-        nested_bin_levels(2.0, 9)
+@pytest.mark.parametrize(("initial", "final"), [(2.0, 9), ("3", 9), (True, 9), (3, None)])
+def test_nested_bin_levels_rejects_non_integers_naming_bins(initial, final):
+    with pytest.raises(ValueError, match="bins must be integers >= 2"):
+        nested_bin_levels(initial, final)
 
 
 def test_masks_of_the_2_to_9_levels():

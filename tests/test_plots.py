@@ -121,11 +121,12 @@ def test_mean_curve_averages_returns_and_places_each_step_at_the_median_wall_tim
 
 
 def test_one_colour_per_agent_and_growth_steps_by_hand():
-    from sb3_gqn.experiments.plots import AGENT_COLORS, agent_colors, growth_steps
+    from sb3_gqn.experiments.plots import AGENT_COLORS, OTHER_COLORS, agent_colors, growth_steps
 
     colors = agent_colors(["sac", "gqn-adaptive", "my-agent", "other-agent"])
     assert colors["gqn-adaptive"] == "tab:green" == AGENT_COLORS["gqn-adaptive"] and colors["sac"] == "tab:purple"
-    assert len(set(colors.values())) == 4 and not set(AGENT_COLORS.values()) & {colors["my-agent"], colors["other-agent"]}
+    assert not set(AGENT_COLORS.values()) & {colors["my-agent"], colors["other-agent"]}
+    assert set(OTHER_COLORS).isdisjoint(AGENT_COLORS.values()) and len(set(OTHER_COLORS)) == len(OTHER_COLORS)
     runs = pd.DataFrame(
         {
             "seed": [0, 0, 1, 1],
@@ -134,6 +135,68 @@ def test_one_colour_per_agent_and_growth_steps_by_hand():
         }
     )
     assert growth_steps(runs) == {3: [5, 7], 5: [12, 15], 9: [18]}
+
+
+def test_an_agents_colour_does_not_depend_on_the_other_agents_of_a_figure():
+    """The walker radar and the drawer-open curves hold different research agents: each keeps its colour."""
+    from sb3_gqn.experiments.plots import agent_color, agent_colors, agent_dashes
+
+    walker = agent_colors(["gqn-adaptive", "gqn-adaptive+expectation0.3", "decqn-9", "sac"])
+    drawer = agent_colors(["gqn-adaptive+from2", "decqn-9", "sac"])
+    alone = agent_colors(["gqn-adaptive+expectation0.3"])
+    assert walker["gqn-adaptive+expectation0.3"] == alone["gqn-adaptive+expectation0.3"]
+    assert drawer["gqn-adaptive+from2"] == agent_color("gqn-adaptive+from2")
+    # two names that pick the same colour in one figure are told apart by their line style
+    names = [f"agent-{index}" for index in range(40)]
+    first, second = next((a, b) for a in names for b in names if a < b and agent_color(a) == agent_color(b))
+    assert agent_dashes([second, first, "sac"]) == {first: "-", second: "--", "sac": "-"}
+
+
+def test_left_out_notes_by_hand():
+    from sb3_gqn.experiments.plots import left_out_note
+
+    assert left_out_note(["a", "b"], ["a", "b"], "x") == "Every agent of the table is drawn."
+    assert left_out_note(["a", "sac", "td3"], ["a"], {"sac": "runs on 2 of 3 tasks"}) == (
+        "Left out: sac (runs on 2 of 3 tasks), td3 (no runs here)."
+    )
+
+
+def figure_texts(figure) -> str:
+    return " ".join(" ".join(text.get_text().split()) for text in figure.texts)
+
+
+def test_every_figure_says_which_agents_it_leaves_out_and_keeps_its_legend_off_the_data(tmp_path, monkeypatch):
+    # sac ran task B only: the IQM across A and B leaves it out, A's curves and radar do not draw it
+    rows = []
+    for algo, env, value in [("gqn-adaptive", "A", -300.0), ("decqn-9", "A", -200.0), ("gqn-adaptive", "B", -100.0),
+                             ("decqn-9", "B", 10.0), ("sac", "B", 50.0)]:  # fmt: skip
+        for seed in (0, 1):
+            for step in (100, 200):
+                final = {"task_return": value, "action_penalty": 1.0, "action_magnitude": 0.5, "action_change": 0.1}
+                rows.append({"algo": algo, "env": env, "penalty": 0.1, "seed": seed, "step": step,
+                             "return": value + seed, "wall_time": step / 10, "growth_events": "", **final,
+                             "smoothness": 0.01})  # fmt: skip
+    results = pd.DataFrame(rows)
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    aggregate(results, tmp_path, reps=50)
+    assert "Left out: sac (runs on 1 of 2 tasks)." in figure_texts(figures[-1])
+    aggregate(results[results["algo"] != "sac"], tmp_path, reps=50, left_out={"sac": "a baseline"})
+    assert "Left out: sac (a baseline)." in figure_texts(figures[-1])
+    figures.pop()
+    plots.learning_curves(results, tmp_path)  # task A, then task B
+    assert "Left out: sac (no runs on this task)." in figure_texts(figures[-2])
+    assert "Every agent of the table is drawn." in figure_texts(figures[-1])
+    smoothness_radar(results, tmp_path)
+    assert "Left out: sac (no runs on this env)." in figure_texts(figures[-2])
+    for figure in figures[1:3] + figures[3:5]:
+        figure.canvas.draw()
+        renderer = figure.canvas.get_renderer()
+        legends = figure.legends + [axis.get_legend() for axis in figure.axes if axis.get_legend() is not None]
+        assert legends
+        for legend in legends:
+            box = legend.get_window_extent(renderer)
+            assert not any(box.overlaps(axis.get_window_extent(renderer)) for axis in figure.axes)
 
 
 def test_success_is_a_third_panel_where_the_task_flags_it(tmp_path, monkeypatch):

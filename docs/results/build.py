@@ -149,7 +149,9 @@ def main_block(table: pd.DataFrame, remedy: pd.DataFrame | None = None) -> str:
     # Curves and radars show SAC where it ran; the IQM figure normalizes over the same runs as the IQM table
     learning_curves(table, RESULTS / "main")
     smoothness_radar(pd.concat([table, remedy]) if remedy is not None and len(remedy) else table, RESULTS / "main")
-    aggregate(main, RESULTS / "main", max_runs=IQM_RUNS)
+    baselines = {agent: "a baseline: the IQM compares GQN with DecQN; its returns are in the task table and the curves"
+                 for agent in BASELINES if agent in set(table["algo"])}  # fmt: skip
+    aggregate(main, RESULTS / "main", max_runs=IQM_RUNS, left_out=baselines)
     iqm = report_sections(main, reps=2000, max_runs=IQM_RUNS)["iqm"]
     across = comparisons_across_tasks(main, MAIN_PAIRS, reps=2000, max_runs=IQM_RUNS)
     per_task = comparisons_per_task(table, [*MAIN_PAIRS, *BASELINE_PAIRS], reps=2000)
@@ -168,12 +170,42 @@ def main_block(table: pd.DataFrame, remedy: pd.DataFrame | None = None) -> str:
     )
 
 
+#: How ``make results`` runs the main job (``sb3-gqn reference-run --out results --timesteps 50000 --threads 1``): the
+#: arguments each committed reference run must have been made with, its seed aside, for the sentence to describe it
+MAIN_JOB_ARGS = {
+    "env": "dm_control/cartpole-swingup-v0",
+    "penalty": 0.1,
+    "algo": "gqn",
+    "bins": [2, 9],
+    "growth": "adaptive",
+    "timesteps": 50_000,
+    "eval_freq": 5_000,
+    "eval_episodes": 5,
+    "final_episodes": 10,
+    "threads": 1,
+}
+
+
+def made_as_make_results(summary: dict) -> list[str]:
+    """The arguments (and the torch threads) in which a reference run's summary differs from :data:`MAIN_JOB_ARGS`."""
+    made = {**summary.get("args", {}), "threads": summary.get("machine", {}).get("threads")}
+    return [
+        f"{key}={made.get(key)!r} (make results: {value!r})" for key, value in MAIN_JOB_ARGS.items() if made.get(key) != value
+    ]
+
+
 def main_job_block(runs: Path = RESULTS / "reference_run") -> str:
     """What the main job (``make results``' reference run) gives over its committed seeds: the final greedy return (10
-    episodes each), the steps at which each level opened, and the env steps/s, as ranges over the seeds."""
-    summaries = [json.loads(path.read_text()) for path in sorted(runs.glob("*/final_evaluation.json"))]
+    episodes each), the steps at which each level opened, and the env steps/s, as ranges over the seeds. Every
+    committed run must have been made as ``make results`` makes its run (:data:`MAIN_JOB_ARGS`), seed aside."""
+    paths = sorted(runs.glob("*/final_evaluation.json"))
+    summaries = [json.loads(path.read_text()) for path in paths]
     if not summaries:
         raise SystemExit(f"no committed reference runs in {runs}")
+    for path, summary in zip(paths, summaries):
+        differences = made_as_make_results(summary)
+        if differences:
+            raise SystemExit(f"{path.parent} was not made as make results makes the main job: {', '.join(differences)}")
     seeds = sorted(int(summary["args"]["seed"]) for summary in summaries)
     returns = [summary["final_evaluation"]["return_mean"] for summary in summaries]
     speeds = [summary["env_steps_per_second"] for summary in summaries]
@@ -187,10 +219,10 @@ def main_job_block(runs: Path = RESULTS / "reference_run") -> str:
         for bins, steps in sorted(opened.items())
     )
     return (
-        f"Over seeds {', '.join(map(str, seeds))} of the committed runs (`docs/results/reference_run/`), the final greedy "
+        f"Over seeds {', '.join(map(str, seeds))} of the committed runs (`docs/results/reference_run/`, each made as `make "
+        "results` makes seed 0's, on one torch thread), the final greedy "
         f"return is {min(returns):.0f}-{max(returns):.0f} (10 episodes each); the levels open {levels}; training runs at "
-        f"{min(speeds):.0f}-{max(speeds):.0f} env steps/s (this 2-core machine, two runs sharing it, one torch thread "
-        "each)."
+        f"{min(speeds):.0f}-{max(speeds):.0f} env steps/s (this 2-core machine, two runs sharing it)."
     )
 
 

@@ -123,3 +123,45 @@ def check_learning_arguments(**arguments: Any) -> dict[str, Any]:
     check_train_freq(arguments["train_freq"])
     check_replay_sizes(checked["buffer_size"], checked["batch_size"], checked["n_steps"])
     return checked
+
+
+#: the replay-buffer keywords GQN sets from its own arguments (``n_steps``, ``gamma``, ``priority_exponent``,
+#: ``importance_sampling_exponent``): a different value in ``replay_buffer_kwargs`` would be silently replaced
+_BUFFER_KEYWORDS = {
+    "n_steps": "n_steps",
+    "gamma": "gamma",
+    "alpha": "priority_exponent",
+    "beta": "importance_sampling_exponent",
+}
+
+
+def check_model_arguments(policy_kwargs: Any, replay_buffer_kwargs: Any, seed: Any, learning: dict[str, Any]) -> None:
+    """The constructor's dictionaries and seed: ``policy_kwargs`` a dict whose ``n_critics`` is an int >= 1 and whose
+    ``net_arch`` a list of ints >= 1; ``replay_buffer_kwargs`` a dict that does not contradict GQN's own arguments
+    (``learning``, checked); ``seed`` ``None`` or an int in ``[0, 2**32 - 1]``. ``ValueError`` naming the argument."""
+    for name, value in (("policy_kwargs", policy_kwargs), ("replay_buffer_kwargs", replay_buffer_kwargs)):
+        if value is not None and not isinstance(value, dict):
+            raise ValueError(f"{name} must be a dict (or None), got {value!r}")
+    policy_kwargs = policy_kwargs or {}
+    if "n_critics" in policy_kwargs:
+        check_int("policy_kwargs['n_critics']", policy_kwargs["n_critics"], 1)
+    net_arch = policy_kwargs.get("net_arch")
+    if net_arch is not None and not (
+        isinstance(net_arch, (list, tuple)) and all(_is_int(size) and size >= 1 for size in net_arch)
+    ):
+        raise ValueError(f"policy_kwargs['net_arch'] must be a list of layer sizes, integers >= 1, got {net_arch!r}")
+    for key, argument in _BUFFER_KEYWORDS.items():
+        if key in (replay_buffer_kwargs or {}) and replay_buffer_kwargs[key] != learning[argument]:
+            raise ValueError(
+                f"replay_buffer_kwargs[{key!r}]={replay_buffer_kwargs[key]!r} contradicts {argument}={learning[argument]!r}, "
+                f"which sets it: pass {argument}={replay_buffer_kwargs[key]!r} instead"
+            )
+    if seed is not None and not (_is_int(seed) and 0 <= seed < 2**32):
+        raise ValueError(f"seed must be None or an integer in [0, 2**32 - 1], got {seed!r}")
+
+
+def check_total_timesteps(value: Any) -> int:
+    """``learn``'s ``total_timesteps``: an integer >= 0 (a float with an integer value, ``1e5``, too) as an int."""
+    if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
+        value = int(value)
+    return check_int("total_timesteps", value, 0)

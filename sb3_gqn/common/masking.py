@@ -57,8 +57,20 @@ def masked_argmax(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
 DECODINGS = ("argmax", "expectation")
 
 
+#: The decoding temperatures a float32 softmax can use: float32's positive normal numbers, from its smallest normal
+#: (1.2e-38; below it a temperature is subnormal, which some CPUs flush to 0, or 0 itself) to its largest (3.4e38;
+#: above it a temperature is inf in float32)
+TEMPERATURE_RANGE = (float(np.finfo(np.float32).tiny), float(np.finfo(np.float32).max))
+
+
 def masked_expectation(q_values: th.Tensor, mask: th.Tensor, bin_values: th.Tensor, temperature: float) -> th.Tensor:
     """Expected bin value per dimension under ``softmax(q_values / temperature)`` over the active set.
+
+    Computed stably: the active set's largest utility is subtracted before the division, so every scaled utility is
+    ``<= 0`` and the greedy bin's is exactly 0 (weight ``exp(0)``): for finite utilities and any temperature in
+    :data:`TEMPERATURE_RANGE` no entry overflows and the weights never sum to 0, so the result is never NaN
+    (``temperature=1.2e-38`` gives the greedy bin's value, ``3.4e38`` the active bins' mean). Inactive bins are set to
+    ``-inf`` after the division.
 
     :param q_values: utilities of shape ``(batch, action_dims, max_bins)``
     :param mask: boolean tensor of shape ``(max_bins,)``, ``True`` = allowed (inactive bins get weight 0)
@@ -66,7 +78,9 @@ def masked_expectation(q_values: th.Tensor, mask: th.Tensor, bin_values: th.Tens
     :param temperature: in the utilities' units; towards 0 it is the greedy bin's value
     :return: ``(batch, action_dims)``, inside the range of the active bins' values
     """
-    weights = th.softmax(q_values.masked_fill(~mask, -th.inf) / temperature, dim=-1)
+    best = masked_max(q_values, mask).unsqueeze(-1)
+    scaled = ((q_values - best) / temperature).masked_fill(~mask, -th.inf)
+    weights = th.softmax(scaled, dim=-1)
     return (weights * bin_values).sum(dim=-1)
 
 

@@ -20,6 +20,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from sb3_gqn.common.arguments import check_number
+
 
 def check_finite_box(action_space: spaces.Space, what: str) -> spaces.Box:
     """Return ``action_space`` if it is a ``Box`` with finite bounds and ``high > low``; raise otherwise."""
@@ -98,11 +100,32 @@ def rescale_to_unit(actions: Any, low: np.ndarray, high: np.ndarray) -> np.ndarr
 
 
 def penalty_bounds(env: gym.Env, coef: float, wrapper: str, what: str) -> tuple[float, np.ndarray, np.ndarray]:
-    """A penalty wrapper's checked coefficient and its env's action bounds (flattened, float64)."""
+    """A penalty wrapper's checked coefficient and its env's action bounds (flattened, float64).
+
+    :raises ValueError: naming ``coef`` unless it is a finite real number >= 0 (``"0.1"``, ``None``, ``True``, an array
+        or NaN are refused)
+    """
     box = check_finite_box(env.action_space, f"{wrapper} (apply it before DiscretizeAction)")
-    if not np.isfinite(coef) or coef < 0:
-        raise ValueError(f"The {what} coefficient must be finite and >= 0, got {coef}")
-    return float(coef), box.low.astype(np.float64).reshape(-1), box.high.astype(np.float64).reshape(-1)
+    try:
+        checked = check_number("coef", coef, low=0.0)
+    except ValueError:
+        raise ValueError(f"{wrapper}: coef, the {what} coefficient, must be a finite number >= 0, got {coef!r}") from None
+    return checked, box.low.astype(np.float64).reshape(-1), box.high.astype(np.float64).reshape(-1)
+
+
+def check_finite_action(action: Any, wrapper: str, size: int | None = None) -> np.ndarray:
+    """``action`` as an array, if every entry is finite; a ``ValueError`` naming the action and the first bad index
+    otherwise (a NaN action would make the penalty, the reward and, for :class:`ActionRatePenalty`, the following
+    observations NaN)."""
+    array = np.asarray(action, dtype=np.float64)
+    if size is not None and array.size != size:
+        raise ValueError(f"{wrapper}: the action {action!r} has {array.size} values, the action space {size}")
+    if not np.isfinite(array).all():
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(array))[0])
+        raise ValueError(
+            f"{wrapper}: the action {action!r} is not finite (index {index}: {array[index]}); the env was not stepped"
+        )
+    return array
 
 
 class ActionPenalty(gym.Wrapper):
@@ -128,6 +151,7 @@ class ActionPenalty(gym.Wrapper):
         return self.coef * float(np.sum(normalized**2))
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_finite_action(action, "ActionPenalty", self._low.size)
         obs, reward, terminated, truncated, info = self.env.step(action)
         penalty = self.penalty(action)
         info = dict(info)
@@ -195,6 +219,7 @@ class ActionRatePenalty(gym.Wrapper):
         return self._observation(observation), info
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_finite_action(action, "ActionRatePenalty", self._low.size)
         observation, reward, terminated, truncated, info = self.env.step(action)
         normalized = np.clip(self.normalize(action), -1.0, 1.0)
         penalty = self.coef * float(np.sum((normalized - self.previous_action) ** 2))

@@ -4,11 +4,33 @@ from __future__ import annotations
 
 from typing import Any, TypeVar
 
+import numpy as np
+from gymnasium import spaces
 from stable_baselines3.common.type_aliases import MaybeCallback
 
+from sb3_gqn.common.envs import resolve_env
 from sb3_gqn.gqn.gqn import GQN
 
 SelfDecQN = TypeVar("SelfDecQN", bound="DecQN")
+
+
+def static_bins(args: tuple[Any, ...], kwargs: dict[str, Any]) -> tuple[int, tuple[Any, ...]]:
+    """DecQN's default ``bins`` for the env among its arguments: the env's ``n`` choices for ``Discrete(n)`` or
+    ``MultiDiscrete([n] * M)``, 9 otherwise (a ``Box``, or no env yet); and the arguments with an env given by id made
+    (``kwargs`` is updated in place)."""
+    if len(args) > 1:
+        env = resolve_env(args[1])
+        args = (args[0], env, *args[2:])
+    else:
+        env = resolve_env(kwargs.get("env"))
+        if "env" in kwargs:
+            kwargs["env"] = env
+    space = getattr(env, "action_space", None)
+    if isinstance(space, spaces.Discrete):
+        return int(space.n), args
+    if isinstance(space, spaces.MultiDiscrete) and len(set(np.ravel(space.nvec).tolist())) == 1:
+        return int(np.ravel(space.nvec)[0]), args
+    return 9, args
 
 
 class DecQN(GQN):
@@ -18,15 +40,19 @@ class DecQN(GQN):
     ``DecQN("MlpPolicy", env, bins=9)`` is the paper's "DecQN 9" baseline, ``bins=2`` its bang-bang
     "DecQN 2". Every other argument is :class:`~sb3_gqn.gqn.gqn.GQN`'s.
 
-    :param bins: bins per action dimension (an int)
+    :param bins: bins per action dimension (an int >= 2; NumPy integers too). ``None`` (default): 9 for a ``Box``,
+        the env's ``n`` choices for ``Discrete(n)``/``MultiDiscrete([n] * M)``
     """
 
-    def __init__(self, *args: Any, bins: int = 9, **kwargs: Any):
+    def __init__(self, *args: Any, bins: int | None = None, **kwargs: Any):
         if "growth" in kwargs and kwargs.pop("growth") is not None:
             raise ValueError("DecQN has a static resolution; use GQN for growth")
-        if not isinstance(bins, int) or isinstance(bins, bool):
-            raise TypeError(f"DecQN takes a single int for bins, got {bins!r}; use GQN for (initial, final) pairs")
-        super().__init__(*args, bins=bins, growth=None, **kwargs)
+        if bins is None:
+            bins, args = static_bins(args, kwargs)
+        if isinstance(bins, (bool, np.bool_)) or not isinstance(bins, (int, np.integer)):
+            pair = " use GQN for (initial, final) pairs" if isinstance(bins, (tuple, list)) else ""
+            raise ValueError(f"bins must be a single int >= 2 for DecQN, got {bins!r};{pair}".rstrip(";"))
+        super().__init__(*args, bins=int(bins), growth=None, **kwargs)
 
     def learn(
         self: SelfDecQN,

@@ -8,12 +8,16 @@ A checkpoint is a folder ``step_<N>/`` under the run's checkpoint folder:
 - ``curve.csv``: the learning curve up to step N;
 - ``state.pkl``: the random number generators (Python, NumPy, PyTorch, the training envs' reset generators) and the
   training seconds so far;
-- ``complete``: written last, with the size of every other file.
+- ``complete``: written last, with the size and the SHA-256 of every other file.
 
-It is written as ``step_<N>.tmp/`` and renamed, so a folder named ``step_<N>`` is whole unless the disk lied; a torn
-one (no ``complete``, a file of another size than recorded, a model zip that fails its CRC check, a ``state.pkl`` that
-does not load) is skipped for the one before it. The replay buffer is checked by size only: it is read once, by the
-resume itself. The last :data:`KEEP` are kept.
+It is written as ``step_<N>.tmp/`` and renamed, so a folder named ``step_<N>`` is whole unless the disk lied. Before a
+run resumes from a checkpoint, the checkpoint proves itself whole: every file has the size and the SHA-256 its
+``complete`` recorded (:func:`is_whole`), so bytes overwritten without a change of size are found too. A checkpoint
+that fails (no ``complete``, a missing file, another size or digest) is skipped, with a warning, for the one before
+it; one whose resume still fails is marked damaged and skipped the same way; with none left the run starts again.
+Checkpoints written before the digests were recorded are accepted unverified by content: their sizes, the model zip's
+CRC check and ``state.pkl`` are checked as then (a ``complete`` without sizes, older still, has its replay buffer
+unpickled instead). The last :data:`KEEP` are kept.
 
 SB3's ``CheckpointCallback`` saves from ``on_step``, which SB3 calls before it stores the step's transition; a resumed
 run would miss that transition and cut the episode in progress. :class:`RunCheckpointCallback` saves at the start of a
@@ -23,6 +27,7 @@ steps, and :class:`ReplayableResets` lets the resumed run's first reset repeat t
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import pickle
@@ -142,11 +147,13 @@ def write_checkpoint(folder: Path, model: Any, curve: Path | None, extra: dict[s
     with open(scratch / "state.pkl", "wb") as handle:
         pickle.dump({"random": random_state(model), **extra}, handle)
     sizes: dict[str, int] = {}
-    for path in scratch.iterdir():  # on disk before the rename makes the folder count
+    digests: dict[str, str] = {}
+    for path in sorted(scratch.iterdir()):  # on disk before the rename makes the folder count
         with open(path, "rb") as handle:
             os.fsync(handle.fileno())
         sizes[path.name] = path.stat().st_size
-    (scratch / COMPLETE).write_text(json.dumps({"step": step, "sizes": sizes}))
+        digests[path.name] = file_digest(path)
+    (scratch / COMPLETE).write_text(json.dumps({"step": step, "sizes": sizes, "sha256": digests}))
     shutil.rmtree(final, ignore_errors=True)
     os.replace(scratch, final)
     for old in checkpoint_steps(folder)[KEEP:]:
@@ -154,19 +161,33 @@ def write_checkpoint(folder: Path, model: Any, curve: Path | None, extra: dict[s
     return final
 
 
+def file_digest(path: Path) -> str:
+    """The SHA-256 of a file's bytes, as hex (read in 1 MiB blocks)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
 def is_whole(checkpoint: Path) -> bool:
-    """Whether a checkpoint folder was written to the end: every file has the size ``complete`` recorded, the model
-    zip passes its CRC check and ``state.pkl`` unpickles. (A ``complete`` without sizes, from an earlier release, has
-    ``replay_buffer.pkl`` unpickled instead.)"""
+    """Whether a checkpoint folder proves itself whole: every file ``complete`` lists has the size and the SHA-256
+    recorded there. A ``complete`` of an earlier release, without digests, is accepted unverified by content: every
+    file has the recorded size, the model zip passes its CRC check and ``state.pkl`` unpickles (without sizes,
+    ``replay_buffer.pkl`` is unpickled too)."""
     import zipfile
 
     try:
         if not (checkpoint / COMPLETE).is_file():
             return False
         record = (checkpoint / COMPLETE).read_text()
-        sizes: dict[str, int] = json.loads(record)["sizes"] if record.lstrip().startswith("{") else {}
+        fields = json.loads(record) if record.lstrip().startswith("{") else {}
+        sizes: dict[str, int] = fields.get("sizes", {})
         if any((checkpoint / name).stat().st_size != size for name, size in sizes.items()):
             return False
+        digests: dict[str, str] = fields.get("sha256", {})
+        if digests:
+            return "model.zip" in digests and all(file_digest(checkpoint / name) == digest for name, digest in digests.items())
         with zipfile.ZipFile(checkpoint / "model.zip") as archive:
             if archive.testzip() is not None:
                 return False
@@ -185,8 +206,16 @@ def newest_whole_checkpoint(folder: Path) -> Path | None:
         checkpoint = folder / f"step_{step}"
         if is_whole(checkpoint):
             return checkpoint
-        warnings.warn(f"checkpoint {checkpoint} is damaged (a torn write?): trying the one before it", stacklevel=2)
+        warnings.warn(
+            f"checkpoint {checkpoint} is damaged (a torn write, or bytes changed since): trying the one before it",
+            stacklevel=2,
+        )
     return None
+
+
+def mark_damaged(checkpoint: Path) -> None:
+    """Take a checkpoint out of the running: its ``complete`` goes, so :func:`is_whole` skips it from now on."""
+    (checkpoint / COMPLETE).unlink(missing_ok=True)
 
 
 def read_state(checkpoint: Path) -> dict[str, Any]:
@@ -206,8 +235,8 @@ class RunCheckpointCallback(BaseCallback):
 
     def __init__(self, folder: Path, freq: int, curve: Path | None = None, extra: Any = None, verbose: int = 0):
         super().__init__(verbose)
-        if freq < 1:
-            raise ValueError(f"checkpoint frequency must be >= 1 env step, got {freq}")
+        if isinstance(freq, bool) or not isinstance(freq, (int, np.integer)) or freq < 1:
+            raise ValueError(f"checkpoint frequency must be an integer >= 1 env step, got {freq!r}")
         self.folder, self.freq, self.curve, self.extra = Path(folder), int(freq), curve, extra
         self.next_step = 0
         self.episode_ended = False

@@ -4,6 +4,7 @@ smoothness radar (figure 4); the Q-value picture (figure 2) is :mod:`~sb3_gqn.ex
 from __future__ import annotations
 
 import textwrap
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -42,7 +43,8 @@ RADAR_CAPTION = (
 RADAR_CLIP = 4.0
 RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 RADAR_DASHES = ("-", "--", "-.", ":")
-#: One colour per agent in every figure; agents not listed take the remaining colours in order of appearance
+#: One colour per agent in every figure: the shipped agents' here; any other agent's chosen by its name
+#: (:func:`agent_color`), so that it is the same in every figure whatever other agents the figure holds
 AGENT_COLORS = {
     "gqn-adaptive": "tab:green",
     "gqn-linear": "tab:olive",
@@ -52,13 +54,46 @@ AGENT_COLORS = {
     "td3": "tab:brown",
     "sbx-sac": "tab:pink",
 }
-_OTHER_COLORS = ("tab:orange", "tab:cyan", "tab:pink", "tab:gray", "gold", "navy", "teal", "maroon")
+#: the colours of the agents :data:`AGENT_COLORS` does not list (none of its colours)
+OTHER_COLORS = (
+    "tab:orange", "tab:cyan", "tab:pink", "tab:gray", "gold", "navy", "teal", "maroon", "black", "lime",
+    "#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d", "#9edae5", "darkgoldenrod",
+)  # fmt: skip
+#: line styles that tell apart two agents of one figure whose names chose the same colour
+COLOR_SHARE_DASHES = ("-", "--", ":", "-.")
+
+
+def agent_color(agent: str) -> str:
+    """One agent's colour in every figure: :data:`AGENT_COLORS`' where it has one, else the one of
+    :data:`OTHER_COLORS` that the CRC-32 of its name picks (stable across figures, runs and machines)."""
+    return AGENT_COLORS.get(agent) or OTHER_COLORS[zlib.crc32(agent.encode()) % len(OTHER_COLORS)]
 
 
 def agent_colors(agents: list[str]) -> dict[str, str]:
-    """The colour of each agent: :data:`AGENT_COLORS`' where it has one, else the next unused of the others."""
-    others = iter(color for color in _OTHER_COLORS if color not in AGENT_COLORS.values())
-    return {agent: AGENT_COLORS.get(agent) or next(others, "black") for agent in agents}
+    """:func:`agent_color` of each agent."""
+    return {agent: agent_color(agent) for agent in agents}
+
+
+def agent_dashes(agents: list[str]) -> dict[str, str]:
+    """Each agent's line style in one figure: solid, unless an agent before it (in sorted order) has its colour; then
+    the next of :data:`COLOR_SHARE_DASHES`."""
+    seen: dict[str, int] = {}
+    dashes = {}
+    for agent in sorted(agents):
+        color = agent_color(agent)
+        dashes[agent] = COLOR_SHARE_DASHES[seen.get(color, 0) % len(COLOR_SHARE_DASHES)]
+        seen[color] = seen.get(color, 0) + 1
+    return dashes
+
+
+def left_out_note(agents: list[str], drawn: list[str], why: dict[str, str] | str) -> str:
+    """The sentence a figure carries on the agents of its table that it does not draw: ``"Left out: sac (runs on 2 of
+    3 tasks)."``, or ``"Every agent of the table is drawn."``. ``why``: one reason for all, or one per agent."""
+    missing = sorted(set(agents) - set(drawn))
+    if not missing:
+        return "Every agent of the table is drawn."
+    reasons = [f"{agent} ({why if isinstance(why, str) else why.get(agent, 'no runs here')})" for agent in missing]
+    return f"Left out: {', '.join(reasons)}."
 
 
 def _slug(text: str) -> str:
@@ -104,9 +139,10 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
     ``warnings`` (e.g. runs whose budget never reached ``learning_starts``) are printed in red on every figure.
     """
     paths = []
+    every_agent = sorted(str(algo) for algo in table["algo"].unique())
     for (env, penalty), task in table.groupby(["env", "penalty"]):
         with_success = "success" in task and task["success"].notna().any()
-        figure, axes = plt.subplots(1, 3 if with_success else 2, figsize=(16 if with_success else 11, 4))
+        figure, axes = plt.subplots(1, 3 if with_success else 2, figsize=(16 if with_success else 11, 5))
         axes[1].sharey(axes[0])
         for index, warning in enumerate(warnings or []):
             figure.text(
@@ -118,7 +154,8 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 fontsize=9,
                 bbox=dict(facecolor="white", alpha=0.85, edgecolor="red"),
             )
-        colors = agent_colors(sorted(task["algo"].unique()))
+        agents = sorted(str(algo) for algo in task["algo"].unique())
+        colors, dashes = agent_colors(agents), agent_dashes(agents)
         # every second agent that grows writes its bin counts below its marks, so two agents' labels stay apart
         growing = [algo for algo, runs in task.groupby("algo") if growth_steps(runs)]
         most_seeds = 0
@@ -129,7 +166,8 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
             most_seeds = max(most_seeds, seeds)
             color = colors[str(algo)]
             for axis, x in zip(axes, (curve.index.to_numpy(), curve["wall"].to_numpy())):
-                axis.plot(x, curve["mean"], label=f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})", color=color)
+                label = f"{algo} ({seeds} seed{'s' if seeds != 1 else ''})"
+                axis.plot(x, curve["mean"], label=label, color=color, linestyle=dashes[str(algo)])
                 axis.fill_between(x, curve["mean"] - half_width, curve["mean"] + half_width, alpha=0.2, color=color)
             _mark_growth_events(axes[0], runs, curve, color, below=algo in growing[1::2])
             success = success_curve(runs)
@@ -137,7 +175,9 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 spread = _half_width(success)
                 # agents drawn later are drawn thinner, so curves that coincide (all at 0, say) stay visible
                 width = 1.5 + 1.0 * (task["algo"].nunique() - 1 - order)
-                axes[2].plot(success.index.to_numpy(), success["mean"], color=color, linewidth=width)
+                axes[2].plot(
+                    success.index.to_numpy(), success["mean"], color=color, linewidth=width, linestyle=dashes[str(algo)]
+                )
                 axes[2].fill_between(
                     success.index.to_numpy(),
                     (success["mean"] - spread).clip(0.0, 1.0),  # a rate's band stays within [0, 1]
@@ -159,10 +199,16 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
                 axes[2].text(0.5, 0.5, "no agent succeeded in any evaluation", transform=axes[2].transAxes, ha="center")
             elif (flagged == 1).all():
                 axes[2].text(0.5, 0.5, "every agent succeeded in every evaluation", transform=axes[2].transAxes, ha="center")
-        axes[0].legend(fontsize=8)
+        # the legend and the note on left-out agents go below the panels, outside the data
+        handles, labels = axes[0].get_legend_handles_labels()
+        columns = min(len(labels), 4)
+        legend_rows = -(-len(labels) // columns)
+        figure.legend(handles, labels, loc="lower center", ncol=columns, fontsize=8, bbox_to_anchor=(0.5, 0.04))
+        note = left_out_note(every_agent, agents, "no runs on this task")
+        figure.text(0.5, 0.005, textwrap.fill(note, 150), ha="center", va="bottom", fontsize=8)
         spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
         figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
-        figure.tight_layout()
+        figure.tight_layout(rect=(0, 0.08 + 0.045 * legend_rows, 1, 1))
         path = out / f"learning_curves_{_slug(env)}_c{penalty:g}.png"
         figure.savefig(path, dpi=110)
         plt.close(figure)
@@ -191,14 +237,27 @@ def _mark_growth_events(axis: Any, runs: pd.DataFrame, curve: pd.DataFrame, colo
             markeredgecolor="black", markeredgewidth=0.5, elinewidth=1, capsize=2,
         )  # fmt: skip
         offset = (0, -14) if below else (0, 7)
-        axis.annotate(str(bins), (median, value), textcoords="offset points", xytext=offset, fontsize=7, ha="center")
+        # on a white ground: a label that lands on another agent's range bar or curve stays readable
+        axis.annotate(
+            str(bins), (median, value), textcoords="offset points", xytext=offset, fontsize=7, ha="center",
+            bbox=dict(boxstyle="round,pad=0.1", facecolor="white", edgecolor="none", alpha=0.8),
+        )  # fmt: skip
 
 
-def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None) -> Path:
+def aggregate(
+    table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | None = None, left_out: dict[str, str] | None = None
+) -> Path:
     """rliable's IQM of min-max normalized final returns across tasks (env, penalty), with 95 % bootstrap CIs, on at
-    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`)."""
+    most ``max_runs`` runs per task and algorithm (its lowest seeds; :func:`equal_run_scores`).
+
+    The figure says which agents it leaves out: those of ``table`` without runs on every task, and ``left_out``, the
+    agents the caller took out of ``table`` before, each with the reason.
+    """
     scores, tasks = normalized_final_scores(table, max_runs)
     estimates, intervals = iqm_with_intervals(scores, reps)
+    covered = {str(algo): len(set(zip(runs["env"], runs["penalty"]))) for algo, runs in final_rows(table).groupby("algo")}
+    reasons = {algo: f"runs on {count} of {len(tasks)} tasks" for algo, count in covered.items()}
+    note = left_out_note([*covered, *(left_out or {})], list(scores), {**reasons, **(left_out or {})})
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
     figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
     colors = agent_colors(sorted(algos))
@@ -219,13 +278,14 @@ def aggregate(table: pd.DataFrame, out: Path, reps: int = 2000, max_runs: int | 
     names = [f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks]
     axis.set_title(f"{len(tasks)} task{'s' if len(tasks) != 1 else ''}: " + textwrap.fill(", ".join(names), 90), fontsize=8)
     degenerate = degenerate_tasks(table)
+    lines = 1 + note.count(",") // 3  # the left-out note's height, roughly
+    figure.text(0.5, 0.01, textwrap.fill(note, 90), ha="center", va="bottom", fontsize=7)
     if degenerate:  # every run of the task ended at the same return: min-max normalization scores them all 0
         listed = ", ".join(f"{env.replace('dm_control/', '')} c={c:g}" for env, c in degenerate)
-        note = f"Normalization degenerate (all final returns equal, all scored 0) on: {listed}"
-        figure.text(0.5, 0.01, textwrap.fill(note, 90), color="red", ha="center", va="bottom", fontsize=7)
-        figure.tight_layout(rect=(0, 0.12, 1, 1))
-    else:
-        figure.tight_layout()
+        warning = f"Normalization degenerate (all final returns equal, all scored 0) on: {listed}"
+        figure.text(0.5, 0.01 + 0.04 * lines, textwrap.fill(warning, 90), color="red", ha="center", va="bottom", fontsize=7)
+        lines += 2
+    figure.tight_layout(rect=(0, 0.05 + 0.045 * lines, 1, 1))
     path = out / "aggregate_iqm.png"
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -267,6 +327,7 @@ def return_radius(returns: np.ndarray, reference: float) -> np.ndarray:
 def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
     """Figure 4 per env: R, P, ``|a|``, ``|Δa|``, SM of the final policies relative to the reference agent."""
     paths = []
+    every_agent = sorted(str(algo) for algo in table["algo"].unique())
     for env, runs in final_rows(table).groupby("env"):
         reference = _reference(runs)
         if reference is None:
@@ -274,7 +335,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         means = runs.groupby(["algo", "penalty"])[list(RADAR_METRICS)].mean()
         base = means.loc[reference].replace(0.0, np.nan)
         angles = np.linspace(0, 2 * np.pi, len(RADAR_METRICS), endpoint=False)
-        figure, axis = plt.subplots(figsize=(6.5, 6.8), subplot_kw={"projection": "polar"})
+        figure, axis = plt.subplots(figsize=(9.5, 6.8), subplot_kw={"projection": "polar"})
         colors = agent_colors(sorted({str(algo) for algo, _ in means.index}))
         any_clipped = False
         for index, ((algo, penalty), values) in enumerate(means.iterrows()):
@@ -308,14 +369,15 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
             axis.set_ylim(0, RADAR_CLIP * 1.05)
         axis.set_xticks(angles, list(RADAR_METRICS.values()))
         axis.set_title(f"{env}: final policies relative to {reference[0]} c={reference[1]:g} (= 1)", fontsize=9)
-        axis.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.2))
+        axis.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.15, 0.5))  # beside the radar, outside the data
         caption = RADAR_CAPTION + (
             f" Ratios above {RADAR_CLIP:g} are drawn at {RADAR_CLIP:g}, their value beside them." if any_clipped else ""
         )
-        figure.text(0.5, 0.01, textwrap.fill(caption, 105), ha="center", va="bottom", fontsize=7)
-        figure.tight_layout(rect=(0, 0.07, 1, 1))
+        caption += " " + left_out_note(every_agent, [str(algo) for algo, _ in means.index], "no runs on this env")
+        figure.text(0.5, 0.01, textwrap.fill(caption, 140), ha="center", va="bottom", fontsize=7)
+        figure.tight_layout(rect=(0, 0.09, 1, 1))
         path = out / f"smoothness_radar_{_slug(env)}.png"
-        figure.savefig(path, dpi=110)
+        figure.savefig(path, dpi=110, bbox_inches="tight")  # the legend beside the radar is inside the image
         plt.close(figure)
         paths.append(path)
     return paths

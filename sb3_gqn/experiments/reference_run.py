@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import platform
 import sys
@@ -30,6 +31,7 @@ from stable_baselines3.common.monitor import Monitor
 from sb3_gqn import GQN, DecQN, __version__
 from sb3_gqn.common.envs import make_env
 from sb3_gqn.common.evaluation import LearningCurveCallback, evaluate
+from sb3_gqn.gqn.growth.schedules import checked_bins
 from sb3_gqn.zoo.hyperparams import HYPERPARAMS_DIR, constructor_arguments, read_entries
 
 
@@ -44,15 +46,39 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument(
         "--hyperparams",
         default=str(HYPERPARAMS_DIR / "gqn.yml"),
-        help="rl-zoo3-style file whose entry for --env supplies GQN arguments (train_freq, bins, ...)",
+        help="rl-zoo3-style file whose entry for --env supplies GQN's other arguments (train_freq, policy_kwargs, ...); "
+        "its bins and growth are ignored: --bins and --growth set them",
     )
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--threads",
+        type=int,
+        default=1,
+        help="torch threads (default 1, as the committed runs in docs/results/reference_run/ were made: another count "
+        "sums in another order and the run follows another path)",
+    )
     parser.add_argument("--eval-freq", type=int, default=5_000, help="env steps between learning-curve evaluations")
     parser.add_argument("--eval-episodes", type=int, default=5, help="episodes per learning-curve evaluation")
     parser.add_argument("--final-episodes", type=int, default=10, help="episodes of the final evaluation")
     parser.add_argument("--out", default="results", help="output folder")
     parser.add_argument("--verbose", type=int, default=1)
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    for name in ("threads", "eval_freq", "eval_episodes", "final_episodes"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be >= 1, got {getattr(args, name)}")
+    if args.timesteps is not None and args.timesteps < 1:
+        parser.error(f"--timesteps must be >= 1, got {args.timesteps}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    if len(args.bins) > 2:
+        parser.error(f"--bins takes one int (static) or two (initial, final), got {args.bins}")
+    try:
+        checked_bins(args.bins[0] if len(args.bins) == 1 else args.bins)
+    except ValueError as error:
+        parser.error(f"--bins: {error}")
+    if not math.isfinite(args.penalty) or args.penalty < 0:
+        parser.error(f"--penalty must be finite and >= 0, got {args.penalty}")
+    return args
 
 
 def load_hyperparams(path: str, env_id: str) -> dict[str, Any]:
@@ -96,7 +122,7 @@ def plot_learning_curve(
     import matplotlib.pyplot as plt
 
     steps = [row["step"] for row in rows]
-    figure, axis = plt.subplots(figsize=(6.4, 4.0))
+    figure, axis = plt.subplots(figsize=(6.4, 4.6))
     axis.plot(steps, [row["return_"] for row in rows], marker="o", label="return (penalized)")
     axis.plot(steps, [row["task_return"] for row in rows], marker=".", linestyle="--", label="task return")
     for step, bins in growth_events:
@@ -110,8 +136,8 @@ def plot_learning_curve(
     axis.set_ylabel("episode return (greedy)")
     axis.set_title(title, fontsize=9)
     axis.grid(alpha=0.3)
-    axis.legend(loc="upper left")
-    figure.tight_layout()
+    figure.legend(*axis.get_legend_handles_labels(), loc="lower center", ncol=2, fontsize=8)  # below, off the data
+    figure.tight_layout(rect=(0, 0.08, 1, 1))
     figure.savefig(path, dpi=120)
     plt.close(figure)
 
@@ -182,7 +208,9 @@ def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
 
 def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn reference-run") -> int:
     """``sb3-gqn reference-run``: returns the exit code."""
-    train_and_evaluate(parse_args(argv, prog))
+    args = parse_args(argv, prog)
+    th.set_num_threads(args.threads)
+    train_and_evaluate(args)
     return 0
 
 

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from sb3_gqn.experiments.scores import (
     equal_run_scores,
@@ -148,9 +149,33 @@ def _cell(value: object) -> str:
     return str(value)
 
 
+#: the columns every results table needs (the runner writes :data:`~sb3_gqn.experiments.runs.COLUMNS`)
+REQUIRED_COLUMNS = ("algo", "env", "penalty", "seed", "step", "return")
+
+
+def read_table(path: Path) -> pd.DataFrame:
+    """One results table.
+
+    :raises ValueError: naming the file when it is empty, not CSV, or lacks a column of :data:`REQUIRED_COLUMNS`
+    """
+    try:
+        table = pd.read_csv(path)
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as error:
+        raise ValueError(f"{path} is not a results table ({type(error).__name__}: {error})") from None
+    missing = [column for column in REQUIRED_COLUMNS if column not in table.columns]
+    if missing:
+        raise ValueError(f"{path} is not a results table: it lacks the columns {missing}")
+    if table.empty:
+        raise ValueError(f"{path} holds no runs (a header without rows)")
+    return table
+
+
 def load(paths: list[Path]) -> pd.DataFrame:
-    """Concatenate results tables (later files win for a run that appears twice)."""
-    tables = [pd.read_csv(path) for path in paths]
+    """Concatenate results tables (later files win for a run that appears twice).
+
+    :raises ValueError: naming a file that is not a results table (:func:`read_table`)
+    """
+    tables = [read_table(path) for path in paths]
     table = pd.concat(tables, ignore_index=True)
     return table.drop_duplicates(subset=["algo", "env", "penalty", "seed", "step"], keep="last")
 
@@ -414,7 +439,12 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     )
     args = parser.parse_args(argv)
     for path in args.variants:
-        load_variants(path)
+        try:
+            load_variants(path)
+        except (OSError, ValueError, yaml.YAMLError) as error:
+            parser.error(f"--variants {path}: {type(error).__name__}: {error}")
+    if args.reps < 1:
+        parser.error(f"--reps must be >= 1, got {args.reps}")
     pairs = [tuple(item.split(":", 1)) for item in args.compare]
     if any(len(pair) != 2 or not all(pair) for pair in pairs):
         parser.error(f"--compare takes A:B pairs of algorithm names, got {args.compare}")
@@ -425,7 +455,11 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     if missing:
         print(f"{prog}: error: no such table: {', '.join(missing)}", file=sys.stderr)
         return 2
-    table = load(args.tables)
+    try:
+        table = load(args.tables)
+    except ValueError as error:
+        print(f"{prog}: error: {error}", file=sys.stderr)
+        return 2
     for env, suffix in shipped:
         table = as_shipped(table, env, suffix)
     filters = {name: getattr(args, name) for name in FILTERS}

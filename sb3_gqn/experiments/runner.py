@@ -21,16 +21,28 @@ return, task return, wall time, smoothness figures, growth events) and sb3_gqn.e
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
+
+import yaml
 
 os.environ.setdefault("MUJOCO_GL", "disable")  # runs render nothing: keep MuJoCo off any GL backend
 
 from sb3_gqn.experiments.checkpoints import DEFAULT_CHECKPOINT_FREQ, KEEP
 from sb3_gqn.experiments.processes import run_in_processes
-from sb3_gqn.experiments.runs import collect, is_finished, progress_line, recorded_rows, run, runs_in_progress
+from sb3_gqn.experiments.runs import (
+    RunInProgressError,
+    collect,
+    is_finished,
+    progress_line,
+    recorded_rows,
+    run,
+    runs_in_progress,
+)
 from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, VARIANTS, RunSpec, load_variants, untrained_runs
 from sb3_gqn.zoo.hyperparams import penalized_env_ids
 
@@ -48,7 +60,10 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     )
     known, _ = variants_parser.parse_known_args(argv)
     for path in known.variants:
-        load_variants(path)
+        try:
+            load_variants(path)
+        except (OSError, ValueError, yaml.YAMLError) as error:  # a missing, unreadable or malformed file
+            argparse.ArgumentParser(prog=prog).error(f"--variants {path}: {type(error).__name__}: {error}")
     parser = argparse.ArgumentParser(
         prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter, parents=[variants_parser]
     )
@@ -100,11 +115,40 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     for key in ("algos", "envs", "penalties", "seeds", "steps"):
         if getattr(args, key) is None:
             setattr(args, key, defaults[key])
+    check_arguments(parser, args)
     if args.eval_freq is None:
         args.eval_freq = max(args.steps // 10, 1)
-    if args.checkpoint_freq < 0:
-        parser.error(f"--checkpoint-freq must be >= 0, got {args.checkpoint_freq}")
+    if args.eval_freq > args.steps:
+        parser.error(f"--eval-freq {args.eval_freq} exceeds --steps {args.steps}: no evaluation would run")
     return args
+
+
+#: integer options and their smallest valid value (``None``: not given, the default applies)
+_MINIMUMS = {
+    "steps": 1,
+    "eval_freq": 1,
+    "eval_episodes": 1,
+    "jobs": 1,
+    "threads": 1,
+    "checkpoint_freq": 0,
+    "ray_retries": 0,
+}
+
+
+def check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse every bad option value before anything is written (``parser.error``: a usage line, exit code 2)."""
+    for name, minimum in _MINIMUMS.items():
+        value = getattr(args, name)
+        if value is not None and value < minimum:
+            parser.error(f"--{name.replace('_', '-')} must be >= {minimum}, got {value}")
+    negative = [seed for seed in args.seeds if seed < 0]
+    if negative:
+        parser.error(f"--seeds must be >= 0 (they seed NumPy), got {negative}")
+    bad = [penalty for penalty in args.penalties if not math.isfinite(penalty) or penalty < 0]
+    if bad:
+        parser.error(f"--penalties must be finite and >= 0, got {bad}")
+    if not math.isfinite(args.ray_gpus) or args.ray_gpus < 0:
+        parser.error(f"--ray-gpus must be a finite number >= 0, got {args.ray_gpus}")
 
 
 def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> int:
@@ -159,19 +203,11 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         )
     elif pending:
         out.mkdir(parents=True, exist_ok=True)
-        by_name = {spec.name: spec for spec in pending}
-        run_in_processes(
-            [
-                (spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads, None, *checkpointing))
-                for spec in pending
-            ],
-            jobs,
-            on_finished=lambda name: print(f"finished {name}"),
-            on_wait=lambda names: print(
-                progress_line(specs, out, {name: by_name[name] for name in names if (out / "runs" / name).exists()}, recorded),
-                flush=True,
-            ),
-        )
+        try:
+            run_pending(pending, specs, out, recorded, args, jobs, threads, checkpointing)
+        except RunInProgressError as error:  # another invocation took a run between the check above and its start
+            print(f"{prog}: error: {error}", file=sys.stderr)
+            return 2
     table = collect(specs, out)
     print(f"results table: {table}")
     if not args.no_plots:
@@ -180,6 +216,29 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         for path in plot_suite(table, out, warnings):
             print(f"plot: {path}")
     return 0
+
+
+def run_pending(
+    pending: list[RunSpec],
+    specs: list[RunSpec],
+    out: Path,
+    recorded: Any,
+    args: argparse.Namespace,
+    jobs: int,
+    threads: int,
+    checkpointing: tuple[int | None, Path | None],
+) -> None:
+    """Train the pending runs in ``jobs`` local processes, printing progress."""
+    by_name = {spec.name: spec for spec in pending}
+    run_in_processes(
+        [(spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads, None, *checkpointing)) for spec in pending],
+        jobs,
+        on_finished=lambda name: print(f"finished {name}"),
+        on_wait=lambda names: print(
+            progress_line(specs, out, {name: by_name[name] for name in names if (out / "runs" / name).exists()}, recorded),
+            flush=True,
+        ),
+    )
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ from sb3_gqn.common.evaluation import LearningCurveCallback
 from sb3_gqn.experiments.checkpoints import (
     RunCheckpointCallback,
     checkpoint_steps,
+    mark_damaged,
     newest_whole_checkpoint,
     read_state,
     restore_random_state,
@@ -218,7 +219,17 @@ def _train(
         config=str(shipped_hyperparams(zoo_algo)),
         trained_agent=str(checkpoint / "model.zip") if checkpoint is not None else "",
     )
-    model, _ = manager.setup_experiment()  # type: ignore[misc]
+    try:
+        model, _ = manager.setup_experiment()  # type: ignore[misc]
+    except Exception as error:  # a checkpoint that is whole by its record but does not load: the one before it
+        if checkpoint is None:
+            raise
+        warnings.warn(
+            f"{spec.name}: resuming from {checkpoint} failed ({type(error).__name__}: {error}): trying the one before it",
+            stacklevel=2,
+        )
+        mark_damaged(checkpoint)
+        return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
     eval_env = make_eval_env(spec)
 
     def on_progress(steps: int) -> None:

@@ -19,6 +19,7 @@ over that algorithm's shipped entry::
 from __future__ import annotations
 
 import inspect
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -128,6 +129,12 @@ class RunSpec:
     variant: Variant | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
+        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
+            raise ValueError(f"steps must be an integer >= 1, got {self.steps!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ValueError(f"seed must be an integer >= 0, got {self.seed!r}")
+        if not math.isfinite(self.penalty) or self.penalty < 0:
+            raise ValueError(f"penalty must be a finite number >= 0, got {self.penalty!r}")
         if self.variant is None:
             if self.algo not in VARIANTS:
                 raise ValueError(f"Unknown agent {self.algo!r}: {', '.join(VARIANTS)} (more through a variants file)")

@@ -18,13 +18,20 @@ from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedul
 from stable_baselines3.common.utils import LinearSchedule, get_parameters_by_name, polyak_update
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.common.arguments import check_choice, check_learning_arguments, check_number
+from sb3_gqn.common.arguments import (
+    check_choice,
+    check_learning_arguments,
+    check_model_arguments,
+    check_number,
+    check_total_timesteps,
+)
 from sb3_gqn.common.buffers import PrioritizedSampling, default_replay_buffer_class
 from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
 from sb3_gqn.common.masking import (
     DECODINGS,
     EXPLORATION_MODES,
+    TEMPERATURE_RANGE,
     active_bin_indices,
     epsilon_greedy,
     masked_expectation,
@@ -40,6 +47,8 @@ from sb3_gqn.gqn.growth.schedules import (
     GROWTH_SCHEDULES,
     AdaptiveGrowth,
     bin_levels_from,
+    checked_bins,
+    default_bins,
 )
 from sb3_gqn.gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.gqn.q_network import DecoupledQNetwork
@@ -50,9 +59,18 @@ SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 def checked_decoding(decoding: str, temperature: float) -> tuple[str, float]:
     """``decoding`` and ``decoding_temperature`` checked (the constructor and ``load``'s keyword arguments): one of
-    :data:`~sb3_gqn.common.masking.DECODINGS`, and a finite temperature > 0 (as a float)."""
+    :data:`~sb3_gqn.common.masking.DECODINGS`, and a temperature a float32 softmax can use (as a float; the range
+    is :data:`~sb3_gqn.common.masking.TEMPERATURE_RANGE`)."""
     check_choice("decoding", decoding, DECODINGS)
-    return decoding, float(check_number("decoding_temperature", temperature, low=0.0, low_open=True))
+    low, high = TEMPERATURE_RANGE
+    try:
+        return decoding, float(check_number("decoding_temperature", temperature, low=low, high=high))
+    except ValueError:
+        raise ValueError(
+            f"decoding_temperature must be a number in [{low:.4g}, {high:.4g}], float32's positive normal range (the "
+            f"utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN), got "
+            f"{temperature!r}"
+        ) from None
 
 
 class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
@@ -107,7 +125,10 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         instead of keeping it constant (DecQN)
     :param bins: bins per action dimension: an ``(initial, final)`` pair grows through the nested levels
         (``(3, 9)``: 3, 5, 9; the paper's ``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. Discrete and
-        MultiDiscrete envs must have ``final`` choices per dimension.
+        MultiDiscrete envs must have ``final`` choices per dimension. ``None`` (default): ``(3, 9)`` for a ``Box``;
+        for ``Discrete(n)``/``MultiDiscrete([n] * M)`` the env's ``n`` choices, grown from 3 when ``n`` is a nested
+        level count (5, 9, 17, ...), else static ``n`` with ``growth=None`` (``CartPole-v1``: ``bins=2``;
+        :func:`~sb3_gqn.gqn.growth.schedules.default_bins`)
     :param growth: ``"adaptive"`` (eq. 4 plus the plateau rule), ``"linear"`` (with ``N`` levels, e.g. ``N = 4`` for
         ``(2, 9)``, level ``g`` opens after ``g / (N + 1)`` of ``total_timesteps``) or ``None`` (stay at the first level)
     :param growth_init: ``"interpolate"``: a newly opened bin's head row starts as the mean of its two nested
@@ -189,7 +210,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         priority_exponent: float = 0.6,
         importance_sampling_exponent: float = 0.2,
         importance_sampling_annealing: bool = False,
-        bins: int | tuple[int, int] = (3, 9),
+        bins: int | tuple[int, int] | None = None,
         growth: str | None = "adaptive",
         growth_init: str = "interpolate",
         growth_eval_freq: int = 2_500,
@@ -220,6 +241,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             max_grad_norm=max_grad_norm, priority_exponent=priority_exponent,
             importance_sampling_exponent=importance_sampling_exponent, stats_window_size=stats_window_size,
         )  # fmt: skip
+        check_model_arguments(policy_kwargs, replay_buffer_kwargs, seed, learning)
         adaptive_schedule = AdaptiveGrowth(
             eval_freq=growth_eval_freq,
             eval_episodes=growth_eval_episodes,
@@ -234,11 +256,21 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         check_choice("exploration", exploration, EXPLORATION_MODES)
         check_choice("precision", precision, PRECISIONS)
         decoding, decoding_temperature = checked_decoding(decoding, decoding_temperature)
-        self.bins = bins
-        self.bin_levels = bin_levels_from(bins)
+        if bins is not None:
+            bins = checked_bins(bins)  # a bad value fails here, before the env is made
         env = resolve_env(env)  # type: ignore[assignment]
         if env is not None:
             check_action_space(env.action_space)
+            if policy == "MlpPolicy" and isinstance(env.observation_space, spaces.Dict):
+                raise ValueError(
+                    f"policy='MlpPolicy' needs a flat observation, but this env's is a Dict ({list(env.observation_space)}"
+                    "): use 'MultiInputPolicy', or flatten it (sb3_gqn.common.envs.make_env(env_id) flattens)"
+                )
+            if bins is None:  # the env's own choices for a Discrete/MultiDiscrete space (default_bins)
+                bins, grows = default_bins(env.action_space)
+                growth = growth if grows else None
+        self.bins = bins
+        self.bin_levels = bin_levels_from(bins) if bins is not None else []
         super().__init__(
             policy,
             env,
@@ -297,6 +329,10 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
 
     def _setup_model(self) -> None:
         # Recomputed here too: load() may pass a new ``bins`` (rl-zoo3's ``-i`` passes the file's hyperparameters)
+        if self.bins is None:  # built without an env: the action space's default now
+            self.bins, grows = default_bins(self.action_space)
+            if not grows:
+                self.growth, self.growth_schedule = None, None
         self.bin_levels = bin_levels_from(self.bins)
         if not 0 <= self.growth_level < len(self.bin_levels):
             raise ValueError(f"Growth level {self.growth_level} does not exist for bins={self.bins} ({self.bin_levels})")
@@ -589,8 +625,10 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             user_callbacks = list(callback)
         elif isinstance(callback, BaseCallback):
             user_callbacks = [callback]
-        else:
+        elif callable(callback):
             user_callbacks = [ConvertCallback(callback)]
+        else:
+            raise ValueError(f"callback must be a BaseCallback, a list of them, a callable or None, got {callback!r}")
         callbacks: list[BaseCallback] = [GrowthCallback(env_was_reset=env_will_reset), *user_callbacks]
         total_timesteps, callback = super()._setup_learn(
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
@@ -623,7 +661,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         progress_bar: bool = False,
     ) -> SelfGQN:
         return super().learn(
-            total_timesteps=total_timesteps,
+            total_timesteps=check_total_timesteps(total_timesteps),
             callback=callback,
             log_interval=log_interval,
             tb_log_name=tb_log_name,

@@ -44,7 +44,9 @@ def decoupled_action_shape(action_space: spaces.Space) -> tuple[int, int]:
             raise ValueError(f"All action dimensions need the same number of bins, got nvec={nvec.tolist()}")
         return len(nvec), int(nvec[0])
     raise TypeError(
-        f"GQN supports Box (discretized), Discrete and MultiDiscrete action spaces, got {type(action_space).__name__}"
+        f"A GQN or DecQN policy acts on bin indices (Discrete or MultiDiscrete), got {action_space}: GQN and DecQN "
+        "discretize a Box themselves, so a GQN or DecQN model file loads only with GQN.load or DecQN.load, not with "
+        "another algorithm's load (SAC.load, DQN.load, ...)"
     )
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import pathlib
+import pickle
 import zipfile
 from typing import Any
 
@@ -17,6 +18,7 @@ from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
 from sb3_gqn.common.buffers import PrioritizedSampling
 from sb3_gqn.common.compact_buffer import compact, expand
+from sb3_gqn.gqn.growth.schedules import bin_levels_from, checked_bins
 
 SavedPath = str | pathlib.Path | io.BufferedIOBase
 
@@ -40,6 +42,33 @@ def saved_data(path: SavedPath) -> dict[str, Any] | None:
         return None
 
 
+def check_model_file(path: SavedPath) -> None:
+    """Refuse a model file that is not whole, with a ``ValueError`` naming it, before SB3 reads it: a truncated zip
+    can still open (its last entry's own zip, a PyTorch file, ends it), without SB3's ``data`` entry (SB3: an
+    ``AssertionError``) or with entries that fail their CRC check. A path that does not exist is left to SB3."""
+    try:
+        if isinstance(path, io.BufferedIOBase):
+            position = path.tell()
+            try:
+                with zipfile.ZipFile(path) as archive:
+                    names, damaged = archive.namelist(), archive.testzip()
+            finally:
+                path.seek(position)
+        else:
+            file = pathlib.Path(path)
+            if not file.exists() and file.with_suffix(".zip").exists():
+                file = file.with_suffix(".zip")
+            if not file.is_file():
+                return
+            with zipfile.ZipFile(file) as archive:
+                names, damaged = archive.namelist(), archive.testzip()
+    except (zipfile.BadZipFile, EOFError, OSError) as error:
+        raise ValueError(f"{path} is not a whole model file (not a readable zip: {error}); it may be truncated") from None
+    if "data" not in names or damaged is not None:
+        why = f"its entry {damaged!r} fails its CRC check" if damaged is not None else "it has no 'data' entry"
+        raise ValueError(f"{path} is not a whole model file ({why}): it is truncated or damaged, or not saved by save()")
+
+
 def saved_algorithm(data: dict[str, Any]) -> str:
     """Which algorithm a model file holds, read from its policy class: ``"GQN"``, ``"DecQN"`` or e.g. ``"SAC"``."""
     policy = data.get("policy_class") or {}
@@ -50,6 +79,66 @@ def saved_algorithm(data: dict[str, Any]) -> str:
     if len(parts) >= 2 and parts[0] in ("stable_baselines3", "sb3_contrib"):
         return parts[1].upper()
     return module or "an unknown algorithm"
+
+
+def levels_for_new_bins(path: SavedPath, data: dict[str, Any], bins: Any) -> dict[str, Any]:
+    """``load(path, bins=...)`` with bins other than the file's: the growth level (and a probation's deployed level)
+    that keep the saved network's active bins under the new ``bins``, as keyword arguments for SB3's ``load``.
+
+    ``(3, 9)`` at level 2 (9 bins) loaded with ``bins=(2, 9)`` is level 3 of ``[2, 3, 5, 9]``.
+
+    :raises ValueError: naming ``bins`` when they are bad, end at another bin count than the saved network holds
+        (``(3, 17)`` for a 9-bin network), or lack the level the model is at (``(5, 9)`` for a model at 3 bins)
+    """
+    new = checked_bins(bins)
+    new_levels, saved_levels = bin_levels_from(new), bin_levels_from(data["bins"])
+    saved = tuple(data["bins"]) if isinstance(data["bins"], list) else data["bins"]
+    if new_levels[-1] != saved_levels[-1]:
+        raise ValueError(
+            f"bins={new} does not fit {path}: its network holds {saved_levels[-1]} bins per action dimension (saved "
+            f"with bins={saved}); load it without bins, or with bins ending in {saved_levels[-1]}"
+        )
+    levels: dict[str, Any] = {}
+    for key in ("growth_level", "_deployed_level"):
+        level = data.get(key, 0 if key == "growth_level" else None)
+        if level is None:
+            continue
+        active = saved_levels[int(level)]
+        if active not in new_levels:
+            raise ValueError(
+                f"bins={new} does not fit {path}: the model acts on {active} bins per dimension (level {level} of "
+                f"{saved_levels}), which bins={new} ({new_levels}) does not hold; load it without bins, or with bins "
+                f"whose levels include {active}"
+            )
+        levels[key] = new_levels.index(active)
+    return levels
+
+
+def check_buffer_fits(path: SavedPath, loaded: ReplayBuffer, current: ReplayBuffer) -> None:
+    """Refuse a replay buffer that this model would learn from wrongly: actions of another space (another
+    algorithm's buffer: SAC's or TD3's float actions would be cast to bin indices), observations of another space, or
+    another n-step return (a 1-step buffer in a 3-step model, or back).
+
+    :raises ValueError: saying what the file holds and what the model needs
+    """
+    if loaded.action_space != current.action_space:
+        raise ValueError(
+            f"{path} holds a replay buffer of actions in {loaded.action_space} ({type(loaded).__name__}), but this model "
+            f"stores bin indices in {current.action_space}: it was saved by another algorithm or for other bins; load "
+            "it into the model that saved it, or start this one with an empty buffer"
+        )
+    if loaded.observation_space != current.observation_space:
+        raise ValueError(
+            f"{path} holds a replay buffer of observations in {loaded.observation_space}, but this model observes "
+            f"{current.observation_space}: start this model with an empty buffer"
+        )
+    have, need = int(getattr(loaded, "n_steps", 1)), int(getattr(current, "n_steps", 1))
+    if have != need and not isinstance(current, HerReplayBuffer):
+        raise ValueError(
+            f"{path} holds a {have}-step replay buffer ({type(loaded).__name__}), but this model learns from {need}-step "
+            f"returns ({type(current).__name__}): load it into a model made with n_steps={have}, or start this one "
+            "with an empty buffer"
+        )
 
 
 class SavedFiles:
@@ -64,6 +153,7 @@ class SavedFiles:
     def load(cls, path: SavedPath, *args: Any, **kwargs: Any) -> Any:
         """SB3's ``load``, after checking that the file holds a model of this class (GQN, or DecQN for
         ``DecQN.load``; a GQN file with static bins loads into either)."""
+        check_model_file(path)
         data = saved_data(path)
         if data is not None:
             holds = saved_algorithm(data)
@@ -74,6 +164,8 @@ class SavedFiles:
             if not fits:
                 extra = f" (bins {data.get('bins')}, growth {data.get('growth')!r})" if holds == "GQN" else ""
                 raise ValueError(f"{path} holds a {holds} model{extra}, not a {wanted} model: load it with {holds}.load")
+            if kwargs.get("bins") is not None and data.get("bins") is not None:
+                kwargs.update(levels_for_new_bins(path, data, kwargs["bins"]))
         return super().load(path, *args, **kwargs)  # type: ignore[misc]
 
     def save_replay_buffer(self, path: SavedPath) -> None:
@@ -87,7 +179,10 @@ class SavedFiles:
         """SB3's ``load_replay_buffer`` for files of :meth:`save_replay_buffer` (and SB3's own), refusing a buffer
         whose sampling (prioritized or uniform) is not the model's: the model would silently change how it learns."""
         current = self.replay_buffer
-        loaded = load_from_pkl(path, self.verbose)
+        try:
+            loaded = load_from_pkl(path, self.verbose)
+        except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, IndexError, ValueError) as error:
+            raise ValueError(f"{path} is not a replay-buffer file ({type(error).__name__}: {error})") from None
         kinds_differ = isinstance(current, PrioritizedSampling) != isinstance(loaded, PrioritizedSampling)
         if isinstance(loaded, ReplayBuffer) and current is not None and kinds_differ:
             have = "prioritized" if isinstance(loaded, PrioritizedSampling) else "uniform"
@@ -97,7 +192,10 @@ class SavedFiles:
                 f"{need} ({type(current).__name__}): load it into a model made with "
                 f"prioritized_replay={have == 'prioritized'}, or start this one with an empty buffer"
             )
-        assert isinstance(loaded, ReplayBuffer), "The replay buffer must inherit from ReplayBuffer class"
+        if not isinstance(loaded, ReplayBuffer):
+            raise ValueError(f"{path} holds a {type(loaded).__name__}, not a replay buffer (an SB3 ReplayBuffer)")
+        if current is not None:
+            check_buffer_fits(path, loaded, current)
         self.replay_buffer = expand(loaded)
         # SB3's own steps after loading (OffPolicyAlgorithm.load_replay_buffer), on the buffer already read
         if isinstance(loaded, HerReplayBuffer):

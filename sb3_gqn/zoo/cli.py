@@ -87,12 +87,14 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
     """A hyperparameter entry, in rl-zoo3's YAML format, that trains GQN on ``env_id`` as printed.
 
     For a ``Box`` action space: the growing bins and the action penalty. For ``Discrete(n)`` (and ``MultiDiscrete``
-    with n choices everywhere): the env's own n choices, growing from 2 when n is a nested level count (3, 5, 9, ...),
-    and no penalty (it needs a ``Box``). ``action_space`` is read from the env when not given; an env that cannot be
-    made gets the ``Box`` entry.
+    with n choices everywhere): the bins GQN takes from such an env without ``bins``
+    (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`: the env's own n choices, growing from 3 when n is a nested
+    level count 5, 9, 17, ..., static otherwise), and no penalty (it needs a ``Box``). ``action_space`` is read from
+    the env when not given; an env that cannot be made gets the ``Box`` entry.
     """
-    import numpy as np
     from gymnasium import spaces
+
+    from sb3_gqn.gqn.growth.schedules import default_bins
 
     if action_space is None:
         try:
@@ -107,12 +109,8 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
         except Exception:  # the template is a hint: an env that cannot be made gets the Box entry
             action_space = None
     lines = [f"{env_id}:", "  n_timesteps: !!float 2e5", "  policy: 'MlpPolicy'"]
-    choices: int | None = None
-    if isinstance(action_space, spaces.Discrete):
-        choices = int(action_space.n)
-    elif isinstance(action_space, spaces.MultiDiscrete) and len(set(np.ravel(action_space.nvec).tolist())) == 1:
-        choices = int(np.ravel(action_space.nvec)[0])
-    if choices is None:
+    even = isinstance(action_space, spaces.MultiDiscrete) and len(set(action_space.nvec.ravel().tolist())) == 1
+    if not (isinstance(action_space, spaces.Discrete) or even):
         lines += [
             "  bins: [3, 9]          # [9, 65] for velocity or position targets",
             "  growth: 'adaptive'",
@@ -120,11 +118,14 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
             "    - sb3_gqn.common.wrappers.ActionPenalty:",
             "        coef: 0.1",
         ]
-    elif choices >= 3 and ((choices - 1) & (choices - 2)) == 0:  # 3, 5, 9, 17, ...: nested levels from 2
-        lines += [f"  bins: [2, {choices}]         # the env's {choices} choices, opened from 2", "  growth: 'adaptive'"]
+        return "\n".join(lines)
+    bins, grows = default_bins(action_space)  # what GQN takes without bins: the same rule
+    if grows:
+        initial, final = bins  # type: ignore[misc]
+        lines += [f"  bins: [{initial}, {final}]         # the env's {final} choices, opened from {initial}"]
+        lines += ["  growth: 'adaptive'"]
     else:
-        lines += [f"  bins: {choices}              # the env's {choices} choices, static"]
-        lines += ["  growth: null"]
+        lines += [f"  bins: {bins}              # the env's {bins} choices, static", "  growth: null"]
     return "\n".join(lines)
 
 
@@ -180,6 +181,8 @@ def _train() -> None:
     from sb3_gqn.zoo import resume
 
     resume.install()  # -i <checkpoint> continues with that checkpoint's replay buffer
+    if "-h" in sys.argv[1:] or "--help" in sys.argv[1:]:  # what the project adds, before rl-zoo3's own help
+        print(TRAIN_HELP)
     sys.argv = [sys.argv[0], *default_train_arguments(sys.argv[1:])]
     zoo_train()
 
@@ -193,6 +196,22 @@ def _enjoy() -> None:
 def _record_video() -> None:
     # rl-zoo3 runs this script's body under __main__; it is executed the same way, after registration
     runpy.run_module("rl_zoo3.record_video", run_name="__main__", alter_sys=False)
+
+
+TRAIN_HELP = """\
+sb3-gqn train: rl-zoo3's train with gqn and decqn registered; every rl-zoo3 option below works.
+
+Without -conf/--conf-file, gqn, decqn, sac and td3 read the project's files, sb3_gqn/zoo/hyperparams/<algo>.yml
+(the same envs, penalties and budgets for all four); an env without an entry fails with an entry printed to start
+from. GQN's and DecQN's own arguments go through -params as Python expressions, over the entry's:
+  -params bins:"(3, 9)" growth:"'linear'" growth_patience:3 decoding:"'expectation'" train_freq:2
+(bins, growth, growth_init, growth_eval_freq, growth_patience, growth_probation, exploration, acting_tau,
+decoding, decoding_temperature, prioritized_replay, n_steps, ...: help(sb3_gqn.GQN)). --n-envs N is short for
+-params n_envs:N; -optimize without --storage keeps its study in <log folder>/<algo>/optuna.db; -i <checkpoint.zip>
+continues with the checkpoint's replay buffer.
+
+rl-zoo3's options:
+"""
 
 
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:

@@ -12,14 +12,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
 import torch as th
 
 from sb3_gqn.common.masking import active_bin_indices, active_bin_mask
 from sb3_gqn.gqn.growth.schedules import interpolation_neighbours
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth
     from sb3_gqn.gqn.policies import GQNPolicy
 
@@ -98,6 +97,8 @@ class GrowingResolution:
         :param probation: keep ``predict`` on the deployed level until :meth:`deploy` (the adaptive schedule's
             probation); by hand (``False``) the level is deployed at once, ending any running probation
         """
+        if level is not None and (isinstance(level, (bool, np.bool_)) or not isinstance(level, (int, np.integer))):
+            raise ValueError(f"level must be an integer index into bin_levels {self.bin_levels} (or None), got {level!r}")
         level = self.growth_level + 1 if level is None else int(level)
         if not self.growth_level <= level < len(self.bin_levels):
             raise ValueError(f"Cannot grow from level {self.growth_level} to {level} (levels: {self.bin_levels})")

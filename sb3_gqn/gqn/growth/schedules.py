@@ -1,7 +1,7 @@
 """When to open the next, finer level of nested bins (paper section 4).
 
-* :func:`nested_bin_levels` lists the resolutions ``2 -> 3 -> 5 -> 9`` (each level doubles the
-  number of intervals between the action bounds).
+* :func:`nested_bin_levels` lists the resolutions, e.g. ``3 -> 5 -> 9`` (the default ``bins=(3, 9)``) or the
+  paper's ``2 -> 3 -> 5 -> 9`` (each level doubles the number of intervals between the action bounds).
 * ``growth="linear"``: :func:`linear_growth_level` opens level ``g`` (0-based, level 0 is
   active from the start) once ``g / (N + 1)`` of the total timesteps have passed, ``N`` being the
   number of levels.
@@ -24,12 +24,17 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from gymnasium import spaces
 
 from sb3_gqn.common.arguments import check_choice, check_int, check_number
 
 GROWTH_SCHEDULES = ("adaptive", "linear", None)
 GROWTH_INITS = ("interpolate", "none")
 RETURN_SOURCES = ("evaluation", "training")
+
+
+def _is_bin_count(value: object) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def nested_bin_levels(initial: int, final: int) -> list[int]:
@@ -39,15 +44,15 @@ def nested_bin_levels(initial: int, final: int) -> list[int]:
     ``[2, 3, 5, 9]``, ``(9, 65)`` gives ``[9, 17, 33, 65]``, ``(3, 9)`` gives ``[3, 5, 9]``,
     ``(9, 9)`` gives ``[9]``.
 
-    :raises ValueError: if ``final`` cannot be reached by doubling from ``initial``
-        (e.g. ``(2, 8)`` or ``(4, 9)``), or either is below 2
+    :raises ValueError: naming ``bins``, if either is not an integer (``2.0``, ``"9"``, ``True``), either is below 2,
+        or ``final`` cannot be reached by doubling from ``initial`` (e.g. ``(2, 8)`` or ``(4, 9)``)
     """
     for name, value in (("initial", initial), ("final", final)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise TypeError(f"bins must be integers, got {name}={value!r}")
+        if not _is_bin_count(value):
+            raise ValueError(f"bins must be integers >= 2, got {name}={value!r} ({type(value).__name__})")
     initial, final = int(initial), int(final)
     if initial < 2:
-        raise ValueError(f"The coarsest level needs at least 2 bins per dimension, got {initial}")
+        raise ValueError(f"bins: the coarsest level needs at least 2 bins per dimension, got {initial}")
     if final < initial:
         raise ValueError(f"bins=({initial}, {final}): the final resolution must not be below the initial one")
     levels = [initial]
@@ -62,12 +67,50 @@ def nested_bin_levels(initial: int, final: int) -> list[int]:
 
 
 def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
-    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`)."""
-    if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool):
-        return nested_bin_levels(int(bins), int(bins))
+    """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`).
+
+    :raises ValueError: naming ``bins`` for anything else: ``"9"``, ``2.5``, ``True``, ``None``, ``(2, 5, 9)``,
+        ``(2.0, 9)``, or bins that cannot nest
+    """
+    if _is_bin_count(bins):
+        return nested_bin_levels(int(bins), int(bins))  # type: ignore[arg-type]
     if isinstance(bins, (tuple, list)) and len(bins) == 2:
         return nested_bin_levels(bins[0], bins[1])
-    raise TypeError(f"bins must be an int or an (initial, final) pair, got {bins!r}")
+    raise ValueError(f"bins must be an int >= 2 or an (initial, final) pair of ints, got {bins!r}")
+
+
+def checked_bins(bins: int | tuple[int, int] | list[int]) -> int | tuple[int, int]:
+    """``bins`` checked (:func:`bin_levels_from`) and normalized to Python ints: ``np.int64(9)`` -> ``9``,
+    ``[np.int64(3), 9]`` -> ``(3, 9)``."""
+    levels = bin_levels_from(bins)
+    return levels[0] if _is_bin_count(bins) else (levels[0], levels[-1])
+
+
+#: the class default's first level: for a ``Box`` it holds the zero action, and it starts the discrete default too
+DEFAULT_INITIAL_BINS = 3
+
+
+def default_bins(action_space: spaces.Space) -> tuple[int | tuple[int, int], bool]:
+    """``bins`` for ``action_space`` when none are given, and whether they grow (more than one level).
+
+    - ``Box``: ``(3, 9)``, the class default.
+    - ``Discrete(n)`` or ``MultiDiscrete([n] * M)``: the env's own ``n`` choices. When ``n`` is a nested level count
+      above the first level (5, 9, 17, 33, 65, ...: ``n - 1`` a power of two) they grow from 3 bins, ``(3, n)``;
+      otherwise (2, 3, 4, 6, 7, ...) ``n`` is a static resolution. ``CartPole-v1`` (``Discrete(2)``) gets ``2``,
+      ``Acrobot-v1`` (``Discrete(3)``) ``3``, ``MultiDiscrete([9, 9])`` ``(3, 9)``.
+    - Any other space (an uneven ``MultiDiscrete`` too): ``(3, 9)``; the action-space check then says what is wrong.
+    """
+    choices: int | None = None
+    if isinstance(action_space, spaces.Discrete):
+        choices = int(action_space.n)
+    elif isinstance(action_space, spaces.MultiDiscrete):
+        counts = set(np.ravel(action_space.nvec).tolist())
+        choices = int(counts.pop()) if len(counts) == 1 else None
+    if choices is None:
+        return (DEFAULT_INITIAL_BINS, 9), True
+    if choices > DEFAULT_INITIAL_BINS and ((choices - 1) & (choices - 2)) == 0:
+        return (DEFAULT_INITIAL_BINS, choices), True
+    return choices, False
 
 
 def adaptive_threshold(mean: float, std: float) -> float:
