@@ -169,8 +169,9 @@ def test_every_precision_learns_saves_and_loads_float32_weights(precision, tmp_p
     )
 
 
-def test_auto_trains_in_bf16_where_the_cpu_has_bf16_units(cpu_with_amx):
-    model = DecQN("MlpPolicy", "Pendulum-v1", bins=9, learning_starts=100, policy_kwargs=SMALL_TORSO, seed=0)
+def test_the_default_is_float32_and_auto_trains_in_bf16_where_the_cpu_has_bf16_units(cpu_with_amx):
+    assert GQN("MlpPolicy", "Pendulum-v1", policy_kwargs=SMALL_TORSO).update_precision == "fp32"
+    model = DecQN("MlpPolicy", "Pendulum-v1", bins=9, learning_starts=100, precision="auto", policy_kwargs=SMALL_TORSO)
     assert (model.precision, model.update_precision) == ("auto", "bf16")
     model.learn(120)  # without bf16 units PyTorch's bf16 kernels are slow: a few updates only
 

@@ -52,7 +52,7 @@ AGENT_COLORS = {
     "decqn-2": "tab:red",
     "sac": "tab:purple",
     "td3": "tab:brown",
-    "sbx-sac": "tab:pink",
+    "sbx-sac": "darkviolet",
 }
 #: the colours of the agents :data:`AGENT_COLORS` does not list (none of its colours)
 OTHER_COLORS = (

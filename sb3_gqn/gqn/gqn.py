@@ -154,11 +154,11 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
     :param decoding_temperature: the softmax temperature of ``decoding="expectation"``, in the utilities' units
         (towards 0 it is the greedy bin)
     :param precision: the arithmetic of the training updates' matrix products (:mod:`sb3_gqn.common.precision`):
-        ``"fp32"``; ``"bf16"``, bfloat16 operands with float32 accumulation, master weights, optimizer state, targets,
-        loss and priorities (on bfloat16 kernels where the device has bfloat16 matrix units, elsewhere as the same
-        arithmetic on float32 kernels, no faster); ``"auto"``: ``"bf16"`` where the device has the units (CPUs with AMX
-        or AVX-512 BF16, CUDA compute capability 8.0 or later), else ``"fp32"``. Acting, saved weights and the exports
-        are float32 in every case
+        ``"fp32"`` (default); ``"bf16"``, bfloat16 operands with float32 accumulation, master weights, optimizer state,
+        targets, loss and priorities (on bfloat16 kernels where the device has bfloat16 matrix units, elsewhere as the
+        same arithmetic on float32 kernels, no faster); ``"auto"``: ``"bf16"`` where the device has the units (CPUs with
+        AMX or AVX-512 BF16, CUDA compute capability 8.0 or later), else ``"fp32"``. Acting, saved weights and the
+        exports are float32 in every case
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -222,7 +222,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         growth_probation: int | None = None,
         decoding: str = "argmax",
         decoding_temperature: float = 0.3,
-        precision: str = "auto",
+        precision: str = "fp32",
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
         policy_kwargs: dict[str, Any] | None = None,
@@ -359,8 +359,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
                 f"decoding='expectation' needs a Box action space (a continuous action between bin values); "
                 f"this env's is {env_action_space}: use decoding='argmax'"
             )
-        # models saved before the option load with the class default, which resolves on the machine that loads them
-        self.precision = getattr(self, "precision", "auto")
+        # models saved before the option trained in float32, the class default
+        self.precision = getattr(self, "precision", "fp32")
         check_choice("precision", self.precision, PRECISIONS)
         #: the precision the updates run in: ``precision`` with ``"auto"`` resolved for this device
         self.update_precision = resolve_precision(self.precision, self.device)
@@ -368,7 +368,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             warnings.warn(
                 f"precision='bf16' on {self.device}, which has no bfloat16 matrix units: the updates round their "
                 "matrix products' operands to bfloat16 on float32 kernels (the same arithmetic as on bfloat16 hardware, "
-                "no faster). precision='auto' trains in float32 here.",
+                "no faster). precision='fp32' or 'auto' train in float32 here.",
                 UserWarning,
                 stacklevel=2,
             )
