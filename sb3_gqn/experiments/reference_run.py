@@ -31,6 +31,7 @@ from stable_baselines3.common.monitor import Monitor
 from sb3_gqn import GQN, DecQN, __version__
 from sb3_gqn.common.envs import make_env
 from sb3_gqn.common.evaluation import LearningCurveCallback, evaluate
+from sb3_gqn.experiments.runner import refuse_below
 from sb3_gqn.gqn.growth.schedules import checked_bins
 from sb3_gqn.zoo.hyperparams import HYPERPARAMS_DIR, constructor_arguments, read_entries
 
@@ -63,13 +64,8 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument("--out", default="results", help="output folder")
     parser.add_argument("--verbose", type=int, default=1)
     args = parser.parse_args(argv)
-    for name in ("threads", "eval_freq", "eval_episodes", "final_episodes"):
-        if getattr(args, name) < 1:
-            parser.error(f"--{name.replace('_', '-')} must be >= 1, got {getattr(args, name)}")
-    if args.timesteps is not None and args.timesteps < 1:
-        parser.error(f"--timesteps must be >= 1, got {args.timesteps}")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed}")
+    minimums = {"threads": 1, "eval_freq": 1, "eval_episodes": 1, "final_episodes": 1, "timesteps": 1, "seed": 0}
+    refuse_below(parser, args, minimums)
     if len(args.bins) > 2:
         parser.error(f"--bins takes one int (static) or two (initial, final), got {args.bins}")
     try:

@@ -135,12 +135,18 @@ _MINIMUMS = {
 }
 
 
-def check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """Refuse every bad option value before anything is written (``parser.error``: a usage line, exit code 2)."""
-    for name, minimum in _MINIMUMS.items():
+def refuse_below(parser: argparse.ArgumentParser, args: argparse.Namespace, minimums: dict[str, int]) -> None:
+    """``parser.error`` (a usage line, exit code 2) for the first option of ``minimums`` whose value lies below its
+    minimum; options left at ``None`` (not given, the default applies) pass."""
+    for name, minimum in minimums.items():
         value = getattr(args, name)
         if value is not None and value < minimum:
             parser.error(f"--{name.replace('_', '-')} must be >= {minimum}, got {value}")
+
+
+def check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse every bad option value before anything is written (``parser.error``: a usage line, exit code 2)."""
+    refuse_below(parser, args, _MINIMUMS)
     negative = [seed for seed in args.seeds if seed < 0]
     if negative:
         parser.error(f"--seeds must be >= 0 (they seed NumPy), got {negative}")
