@@ -77,13 +77,13 @@ def test_learn_save_and_load_keep_the_decoding(tmp_path):
     np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], model.predict(batch, deterministic=True)[0])
 
 
-RANGE = r"decoding_temperature must be a number in \[1\.175e-38, 3\.403e\+38\], float32's positive normal range"
+RANGE = r"decoding_temperature must be None or a number in \[1\.175e-38, 3\.403e\+38\], float32's positive normal range"
 
 
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation'\), got 'median'"),
+        (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation', 'relative'\), got 'median'"),
         (dict(decoding="expectation", decoding_temperature=0.0), RANGE + r".*got 0\.0"),
         (dict(decoding_temperature=float("nan")), RANGE + ".*got nan"),
         (dict(decoding_temperature=True), RANGE + ".*got True"),

@@ -6,14 +6,17 @@ learning-curve callback that evaluates during training.
 * :func:`evaluate` summarizes them as returns (:class:`Evaluation`), :func:`rollout_figures` as the paper's figure 4
   metrics (:class:`~sb3_gqn.common.smoothness.SmoothnessFigures`);
 * :class:`LearningCurveCallback` evaluates every ``eval_freq`` environment steps and at the end of training, and hands
-  every row to the caller (the reference run writes ``learning_curve.csv``, the comparison runner ``curve.csv``).
+  every row to the caller (the reference run writes ``learning_curve.csv``, the comparison runner ``curve.csv``);
+  with ``paired_decodings`` it reads the same model on the same episodes with other decodings too
+  (:func:`decoded_as`).
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -158,6 +161,18 @@ def growth_columns(model: Any) -> dict[str, Any]:
     }
 
 
+@contextmanager
+def decoded_as(model: Any, decoding: str) -> Iterator[Any]:
+    """Inside the block, ``model``'s deterministic ``predict`` uses ``decoding`` at that decoding's default
+    temperature (a model with GQN's ``decoding`` and ``decoding_temperature`` attributes); both are restored after."""
+    saved = model.decoding, model.decoding_temperature
+    model.decoding, model.decoding_temperature = decoding, None
+    try:
+        yield model
+    finally:
+        model.decoding, model.decoding_temperature = saved
+
+
 class LearningCurveCallback(BaseCallback):
     """Evaluates greedily every ``eval_freq`` environment steps and at the end of training.
 
@@ -171,6 +186,9 @@ class LearningCurveCallback(BaseCallback):
     :param seed: seed of each evaluation's first episode (episode k uses ``seed + k``): every evaluation starts from
         the same initial states
     :param on_row: called with every row as it is made
+    :param paired_decodings: decodings (GQN's ``decoding`` values) that also read the model at every evaluation, on
+        the same episodes (same seeds): each adds a row with ``decoding`` set to its name after the model's own row,
+        whose figures and growth events are those of the model's own decoding (a row without ``decoding``)
     :param on_progress: called with the env steps every ``progress_every`` environment steps
     :param progress_every: steps between ``on_progress`` calls
     :param verbose: 1 prints a line per evaluation
@@ -183,6 +201,7 @@ class LearningCurveCallback(BaseCallback):
         n_episodes: int = 5,
         seed: int | None = None,
         on_row: Callable[[dict[str, Any]], None] | None = None,
+        paired_decodings: Sequence[str] = (),
         on_progress: Callable[[int], None] | None = None,
         progress_every: int = 500,
         verbose: int = 0,
@@ -190,6 +209,7 @@ class LearningCurveCallback(BaseCallback):
         super().__init__(verbose)
         self.eval_env, self.eval_freq, self.n_episodes, self.seed = eval_env, eval_freq, n_episodes, seed
         self.on_row, self.on_progress, self.progress_every = on_row, on_progress, progress_every
+        self.paired_decodings = tuple(paired_decodings)
         self.rows: list[dict[str, Any]] = []
         self.train_seconds, self.last_eval, self.started = 0.0, 0, 0.0
 
@@ -207,11 +227,17 @@ class LearningCurveCallback(BaseCallback):
             **figures.as_dict(),
             **growth_columns(self.model),
         }
-        self.rows.append(row)
         self.logger.record("eval/return", figures.return_)
         self.logger.record("eval/task_return", figures.task_return)
-        if self.on_row is not None:
-            self.on_row(row)
+        paired = []
+        for decoding in self.paired_decodings:
+            with decoded_as(self.model, decoding):
+                read = rollout_figures(self.model, self.eval_env, self.n_episodes, seed=self.seed)
+            paired.append({**row, **read.as_dict(), "decoding": decoding})
+        for made in (row, *paired):
+            self.rows.append(made)
+            if self.on_row is not None:
+                self.on_row(made)
         if self.verbose >= 1:
             print(
                 f"step {row['step']:>7d}  return {figures.return_:8.1f}  task {figures.task_return:8.1f}  "

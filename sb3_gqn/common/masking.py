@@ -53,8 +53,12 @@ def masked_argmax(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
 
 
 #: How ``predict`` (deterministic) and the exports turn utilities into actions: the greedy bin (``"argmax"``, the
-#: paper) or, for a ``Box`` action space, the expected bin value under a softmax of the utilities (``"expectation"``)
-DECODINGS = ("argmax", "expectation")
+#: paper) or, for a ``Box`` action space, the expected bin value under a softmax of the utilities, at a temperature in
+#: the utilities' units (``"expectation"``) or relative to each state's spread of utilities (``"relative"``)
+DECODINGS = ("argmax", "expectation", "relative")
+
+#: the temperature each softmax decoding uses when none is given
+DEFAULT_DECODING_TEMPERATURES = {"expectation": 0.3, "relative": 0.3}
 
 
 #: The decoding temperatures a float32 softmax can use: float32's positive normal numbers, from its smallest normal
@@ -63,23 +67,37 @@ DECODINGS = ("argmax", "expectation")
 TEMPERATURE_RANGE = (float(np.finfo(np.float32).tiny), float(np.finfo(np.float32).max))
 
 
-def masked_expectation(q_values: th.Tensor, mask: th.Tensor, bin_values: th.Tensor, temperature: float) -> th.Tensor:
-    """Expected bin value per dimension under ``softmax(q_values / temperature)`` over the active set.
+def masked_expectation(
+    q_values: th.Tensor, mask: th.Tensor, bin_values: th.Tensor, temperature: float, relative: bool = False
+) -> th.Tensor:
+    """Expected bin value per dimension under a softmax of the utilities over the active set.
 
-    Computed stably: the active set's largest utility is subtracted before the division, so every scaled utility is
-    ``<= 0`` and the greedy bin's is exactly 0 (weight ``exp(0)``): for finite utilities and any temperature in
+    The weights are ``softmax((u - max u) / temperature)`` (``relative=False``: the temperature is in the utilities'
+    units) or ``softmax((u - max u) / (temperature * (max u - min u)))`` (``relative=True``: the maximum and minimum
+    are that state's and dimension's over the active bins, so the greedy bin's scaled utility is 0, the worst bin's
+    ``-1 / temperature`` and the decoding does not change when a task's rewards, hence its utilities, are scaled).
+
+    Computed stably: the active set's largest utility is subtracted first, so every scaled utility is ``<= 0`` and
+    the greedy bin's is exactly 0 (weight ``exp(0)``): for finite utilities and any temperature in
     :data:`TEMPERATURE_RANGE` no entry overflows and the weights never sum to 0, so the result is never NaN
-    (``temperature=1.2e-38`` gives the greedy bin's value, ``3.4e38`` the active bins' mean). Inactive bins are set to
-    ``-inf`` after the division.
+    (``temperature=1.2e-38`` gives the greedy bin's value, ``3.4e38`` the active bins' mean; a dimension whose active
+    utilities are all equal gets the active bins' mean under ``relative=True``). Inactive bins are set to ``-inf``
+    after the division.
 
     :param q_values: utilities of shape ``(batch, action_dims, max_bins)``
     :param mask: boolean tensor of shape ``(max_bins,)``, ``True`` = allowed (inactive bins get weight 0)
     :param bin_values: each bin's env value, ``(action_dims, max_bins)``
-    :param temperature: in the utilities' units; towards 0 it is the greedy bin's value
+    :param temperature: towards 0 the decoding is the greedy bin's value
+    :param relative: scale the temperature by each state's and dimension's spread of active utilities
     :return: ``(batch, action_dims)``, inside the range of the active bins' values
     """
     best = masked_max(q_values, mask).unsqueeze(-1)
-    scaled = ((q_values - best) / temperature).masked_fill(~mask, -th.inf)
+    below_best = q_values - best
+    if relative:
+        worst = q_values.masked_fill(~mask, th.inf).amin(dim=-1, keepdim=True)
+        # a spread of 0 (all active utilities equal) leaves every active entry at 0: uniform weights
+        below_best = below_best / (best - worst).clamp_min(TEMPERATURE_RANGE[0])
+    scaled = (below_best / temperature).masked_fill(~mask, -th.inf)
     weights = th.softmax(scaled, dim=-1)
     return (weights * bin_values).sum(dim=-1)
 

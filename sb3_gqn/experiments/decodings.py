@@ -6,7 +6,9 @@ between bins. Two decodings act on the same utilities ``u[j, k]`` (dimension ``j
 - :class:`Hysteresis` ``(margin)``: per dimension, keep the previous step's bin unless another active bin's utility
   beats it by more than ``margin`` (the first step of an episode is greedy);
 - :class:`SoftmaxExpectation` ``(temperature)``: per dimension, the expected bin value under
-  ``softmax(u[j, :] / temperature)`` over the active bins, a continuous action (``Box`` envs only).
+  ``softmax(u[j, :] / temperature)`` over the active bins, a continuous action (``Box`` envs only); with
+  ``relative=True`` the temperature is scaled by the state's spread ``max u[j, :] - min u[j, :]`` (GQN's
+  ``decoding="relative"``).
 
 :func:`compare_decodings` evaluates each on a trained model with the suite's greedy-episode protocol and reports task
 return, return, SM and ``|Δa|`` (:func:`sb3_gqn.common.evaluation.rollout_figures`).
@@ -77,14 +79,15 @@ class Hysteresis(Decoding):
 
 
 class SoftmaxExpectation(Decoding):
-    """The expected bin value under a softmax of the utilities at ``temperature``, per dimension (``Box`` envs)."""
+    """The expected bin value under a softmax of the utilities at ``temperature``, per dimension (``Box`` envs);
+    ``relative``: the temperature relative to the state's spread of utilities."""
 
-    def __init__(self, model: GQN, temperature: float):
+    def __init__(self, model: GQN, temperature: float, relative: bool = False):
         super().__init__(model)
         if model.action_grid is None:
             raise ValueError("SoftmaxExpectation needs a Box action space (a continuous action between bin values)")
-        self.temperature = float(temperature)
-        self.name = f"softmax {temperature:g}"
+        self.temperature, self.relative = float(temperature), relative
+        self.name = f"{'relative' if relative else 'softmax'} {temperature:g}"
 
     def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True) -> Any:
         grid = self.model.action_grid
@@ -92,7 +95,7 @@ class SoftmaxExpectation(Decoding):
         utilities = th.as_tensor(self.utilities(observation))  # -inf on inactive bins: weight 0
         mask = self.model.policy.active_bins_mask.cpu()
         bin_values = th.as_tensor(grid.values, dtype=utilities.dtype)
-        values = masked_expectation(utilities[None], mask, bin_values, self.temperature)[0].numpy()
+        values = masked_expectation(utilities[None], mask, bin_values, self.temperature, self.relative)[0].numpy()
         return values.reshape(grid.box.shape).astype(grid.box.dtype), state
 
 
@@ -144,6 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--penalty", type=float, default=0.1)
     parser.add_argument("--margins", type=float, nargs="*", default=[0.1, 0.3, 1.0, 3.0])
     parser.add_argument("--temperatures", type=float, nargs="*", default=[0.03, 0.1, 0.3, 1.0])
+    parser.add_argument("--relative-temperatures", type=float, nargs="*", default=[])
     parser.add_argument("--episodes", type=int, default=5)
     parser.add_argument("--csv", help="also write every model's rows to this CSV file")
     args = parser.parse_args(argv)
@@ -153,6 +157,7 @@ def main(argv: list[str] | None = None) -> int:
         model = GQN.load(path, env=env)
         decodings = [Decoding(model), *(Hysteresis(model, m) for m in args.margins)]
         decodings += [SoftmaxExpectation(model, t) for t in args.temperatures]
+        decodings += [SoftmaxExpectation(model, t, relative=True) for t in args.relative_temperatures]
         for row in compare_decodings(model, env, decodings, n_episodes=args.episodes):
             rows.append({"model": path, **row})
         env.close()

@@ -22,6 +22,7 @@ from sb3_gqn.experiments.scores import (
     iqm_with_intervals,
     normalized_final_scores,
     run_growth_events,
+    with_paired_readings,
 )
 
 #: Figure 4's axes: column of results.csv -> label
@@ -385,7 +386,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
 
 def plot_suite(table_path: Path, out: Path, warnings: list[str] | None = None) -> list[Path]:
     """All figures for a results table; returns the written paths (``warnings``: see :func:`learning_curves`)."""
-    table = pd.read_csv(table_path)
+    table = with_paired_readings(pd.read_csv(table_path))
     if table.empty:
         return []
     paths = [*learning_curves(table, out, warnings), aggregate(table, out), *smoothness_radar(table, out)]

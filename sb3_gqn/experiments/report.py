@@ -40,6 +40,7 @@ from sb3_gqn.experiments.scores import (
     normalized_final_runs,
     normalized_final_scores,
     run_growth_events,
+    with_paired_readings,
 )
 from sb3_gqn.experiments.significance import (
     difference_interval,
@@ -167,7 +168,7 @@ def read_table(path: Path) -> pd.DataFrame:
         raise ValueError(f"{path} is not a results table: it lacks the columns {missing}")
     if table.empty:
         raise ValueError(f"{path} holds no runs (a header without rows)")
-    return table
+    return with_paired_readings(table)
 
 
 def load(paths: list[Path]) -> pd.DataFrame:

@@ -54,7 +54,21 @@ COLUMNS = [
     "deployed_bins",
     "deployments",
     "success",
+    "decoding",
 ]
+
+#: the decoding a run's final model and evaluations are also read with, by the model's own decoding: the smooth
+#: default beside the paper's argmax, and the argmax beside a softmax decoding
+PAIRED_DECODING = {"argmax": "relative", "expectation": "argmax", "relative": "argmax"}
+
+
+def paired_decodings(model: Any) -> tuple[str, ...]:
+    """The decodings :class:`~sb3_gqn.common.evaluation.LearningCurveCallback` reads ``model`` with besides its own:
+    the :data:`PAIRED_DECODING` of a GQN or DecQN with a ``Box`` action space; none for other models (SAC, a
+    ``Discrete`` action space), which act one way."""
+    if getattr(model, "action_grid", None) is None or not hasattr(model, "decoding"):
+        return ()
+    return (PAIRED_DECODING[model.decoding],)
 
 
 def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
@@ -80,11 +94,21 @@ def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
         "deployed_bins": row["deployed_bins"],
         "deployments": row["deployments"],
         "success": "" if math.isnan(row["success"]) else row["success"],
+        "decoding": row.get("decoding", ""),
     }
 
 
 def append_row(path: Path, row: dict[str, Any]) -> None:
-    """Append one :data:`COLUMNS` row to the csv file ``path`` (with the header when the file is new)."""
+    """Append one :data:`COLUMNS` row to the csv file ``path`` (with the header when the file is new; a file an
+    earlier release began, with fewer columns, is rewritten under today's header first)."""
+    if path.is_file() and path.stat().st_size:
+        with open(path, newline="") as handle:
+            earlier = list(csv.DictReader(handle))
+        if earlier and list(earlier[0]) != COLUMNS:
+            with open(path, "w", newline="") as handle:
+                writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
+                writer.writeheader()
+                writer.writerows({column: old.get(column, "") for column in COLUMNS} for old in earlier)
     with open(path, "a", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=COLUMNS)
         if handle.tell() == 0:
@@ -243,6 +267,7 @@ def _train(
         eval_episodes,
         seed=10_000 + spec.seed,
         on_row=lambda row: append_row(run_dir / "curve.csv", curve_row(spec, row)),
+        paired_decodings=paired_decodings(model),
         on_progress=on_progress,
     )
     callbacks: list[Any] = [*manager.callbacks, curve]

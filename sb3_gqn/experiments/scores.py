@@ -9,6 +9,21 @@ import pandas as pd
 from sb3_gqn.experiments.significance import seeded_numpy_global_generator
 
 
+def with_paired_readings(table: pd.DataFrame) -> pd.DataFrame:
+    """The table with every paired reading (a row whose ``decoding`` names the decoding that read the run's model
+    beside its own, see :data:`~sb3_gqn.experiments.runs.PAIRED_DECODING`) as an agent of its own, ``algo (decoding)``:
+    every table and figure then shows a run's two decodings side by side. Tables without the column are unchanged."""
+    if "decoding" not in table.columns:
+        return table
+    decoding = table["decoding"].fillna("").astype(str)
+    paired = decoding != ""
+    if not paired.any():
+        return table
+    labelled = table.copy()
+    labelled.loc[paired, "algo"] = labelled.loc[paired, "algo"].astype(str) + " (" + decoding[paired] + ")"
+    return labelled
+
+
 def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list[tuple[int, int]]:
     """``(step, bins)`` growth events of one run, from the ``growth_events`` column of its last row (``deployments``:
     the changes of the level its evaluations acted on)."""

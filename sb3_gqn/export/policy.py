@@ -65,8 +65,8 @@ class DeployedPolicy(nn.Module):
     one-hot for discrete parts, flattening, via the network's own features extractor) -> torso -> head (with
     several critics: their element-wise maximum) -> argmax over the active bins (paper eq. 3, the mask baked in)
     -> each bin's env value (``Box``: the bin grid ``linspace(low, high, max_bins)`` per dimension, reshaped to the
-    action space's shape, or with ``decoding="expectation"`` the softmax-weighted mean of the active bins' values;
-    ``Discrete``: the index; ``MultiDiscrete``: the indices).
+    action space's shape, or with ``decoding="expectation"`` or ``"relative"`` the softmax-weighted mean of the active
+    bins' values; ``Discrete``: the index; ``MultiDiscrete``: the indices).
 
     A copy on the CPU, in evaluation mode: later training of ``model`` does not change it. Observations are
     batched (first dimension) and laid out as the policy sees them (images channel-first, as SB3's
@@ -95,9 +95,12 @@ class DeployedPolicy(nn.Module):
             # bin_values[j, k]: the env value of bin k in action dimension j
             self.register_buffer("bin_values", th.as_tensor(model.action_grid.values))
             self.action_shape = tuple(model.action_grid.box.shape)
-        # decoding="expectation": the softmax-weighted bin value, as predict() gives it; None: the greedy bin's value
-        expectation = self.continuous and getattr(model, "decoding", "argmax") == "expectation"
-        self.expectation_temperature: float | None = float(model.decoding_temperature) if expectation else None
+        # decoding="expectation" or "relative": the softmax-weighted bin value, as predict() gives it; None: the greedy
+        # bin's value
+        decoding = getattr(model, "decoding", "argmax")
+        softmax = self.continuous and decoding != "argmax"
+        self.expectation_temperature: float | None = float(model.softmax_temperature) if softmax else None
+        self.relative_temperature = decoding == "relative"
         self.discrete = isinstance(self.action_space, spaces.Discrete)
         self.action_dims = policy.action_dims
         self.eval()
@@ -110,7 +113,13 @@ class DeployedPolicy(nn.Module):
         bins = masked_argmax(utilities, self.active_bins_mask)  # (batch, action_dims)
         if self.continuous:
             if self.expectation_temperature is not None:
-                values = masked_expectation(utilities, self.active_bins_mask, self.bin_values, self.expectation_temperature)
+                values = masked_expectation(
+                    utilities,
+                    self.active_bins_mask,
+                    self.bin_values,
+                    self.expectation_temperature,
+                    relative=self.relative_temperature,
+                )
             else:
                 values = self.bin_values.expand(bins.shape[0], -1, -1).gather(2, bins.unsqueeze(-1)).squeeze(-1)
             actions = values.reshape((-1, *self.action_shape))

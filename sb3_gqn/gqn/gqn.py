@@ -30,6 +30,7 @@ from sb3_gqn.common.envs import check_action_space, resolve_env
 from sb3_gqn.common.finite import as_batch, check_finite_observation
 from sb3_gqn.common.masking import (
     DECODINGS,
+    DEFAULT_DECODING_TEMPERATURES,
     EXPLORATION_MODES,
     TEMPERATURE_RANGE,
     active_bin_indices,
@@ -57,19 +58,22 @@ from sb3_gqn.gqn.saving import SavedFiles
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
-def checked_decoding(decoding: str, temperature: float) -> tuple[str, float]:
+def checked_decoding(decoding: str, temperature: float | None) -> tuple[str, float | None]:
     """``decoding`` and ``decoding_temperature`` checked (the constructor and ``load``'s keyword arguments): one of
-    :data:`~sb3_gqn.common.masking.DECODINGS`, and a temperature a float32 softmax can use (as a float; the range
-    is :data:`~sb3_gqn.common.masking.TEMPERATURE_RANGE`)."""
+    :data:`~sb3_gqn.common.masking.DECODINGS`, and ``None`` (the decoding's own default,
+    :data:`~sb3_gqn.common.masking.DEFAULT_DECODING_TEMPERATURES`) or a temperature a float32 softmax can use (as a
+    float; the range is :data:`~sb3_gqn.common.masking.TEMPERATURE_RANGE`)."""
     check_choice("decoding", decoding, DECODINGS)
+    if temperature is None:
+        return decoding, None
     low, high = TEMPERATURE_RANGE
     try:
         return decoding, float(check_number("decoding_temperature", temperature, low=low, high=high))
     except ValueError:
         raise ValueError(
-            f"decoding_temperature must be a number in [{low:.4g}, {high:.4g}], float32's positive normal range (the "
-            f"utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN), got "
-            f"{temperature!r}"
+            f"decoding_temperature must be None or a number in [{low:.4g}, {high:.4g}], float32's positive normal "
+            f"range (the utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN), "
+            f"got {temperature!r}"
         ) from None
 
 
@@ -148,11 +152,13 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         ``k`` keeps greedy actions and the TD target's max on the deployed level until a greedy episode over the opened
         one holds 70 % of its return, at most ``k`` tries (:class:`~sb3_gqn.gqn.growth.AdaptiveGrowth`)
     :param decoding: how deterministic ``predict`` and the exports turn utilities into actions: ``"argmax"``, the
-        greedy bin (the paper); ``"expectation"`` (``Box`` action spaces), the expected bin value under a softmax of the
-        utilities over the deployed bins at ``decoding_temperature``, a continuous action that does not chatter
-        between neighbouring bins. Training (exploration, growth's greedy episodes, the TD target) is unchanged
-    :param decoding_temperature: the softmax temperature of ``decoding="expectation"``, in the utilities' units
-        (towards 0 it is the greedy bin)
+        greedy bin (the paper); for ``Box`` action spaces, the expected bin value under a softmax of the utilities over
+        the deployed bins, a continuous action that does not chatter between neighbouring bins, tempered in the
+        utilities' units (``"expectation"``) or relative to each state's spread of utilities, largest minus smallest
+        per dimension (``"relative"``: the same temperature serves tasks whose rewards differ in scale). Training
+        (exploration, growth's greedy episodes, the TD target) is unchanged
+    :param decoding_temperature: the softmax temperature; ``None``: the decoding's default (0.3 for both; towards 0
+        a softmax decoding is the greedy bin)
     :param precision: the arithmetic of the training updates' matrix products (:mod:`sb3_gqn.common.precision`):
         ``"fp32"`` (default); ``"bf16"``, bfloat16 operands with float32 accumulation, master weights, optimizer state,
         targets, loss and priorities (on bfloat16 kernels where the device has bfloat16 matrix units, elsewhere as the
@@ -221,7 +227,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         growth_min_improvement: float = 0.05,
         growth_probation: int | None = None,
         decoding: str = "argmax",
-        decoding_temperature: float = 0.3,
+        decoding_temperature: float | None = None,
         precision: str = "fp32",
         stats_window_size: int = 100,
         tensorboard_log: str | None = None,
@@ -352,11 +358,11 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         # load() sets its keyword arguments on the model before this runs: check them as the constructor does
         # (models saved before the option act on the argmax)
         self.decoding, self.decoding_temperature = checked_decoding(
-            getattr(self, "decoding", "argmax"), getattr(self, "decoding_temperature", 0.3)
+            getattr(self, "decoding", "argmax"), getattr(self, "decoding_temperature", None)
         )
-        if self.decoding == "expectation" and self.action_grid is None:
+        if self.decoding != "argmax" and self.action_grid is None:
             raise ValueError(
-                f"decoding='expectation' needs a Box action space (a continuous action between bin values); "
+                f"decoding={self.decoding!r} needs a Box action space (a continuous action between bin values); "
                 f"this env's is {env_action_space}: use decoding='argmax'"
             )
         # models saved before the option trained in float32, the class default
@@ -488,7 +494,7 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         :return: the model's action and the next hidden state (used in recurrent policies)
         """
         check_finite_observation(as_batch(observation, self.observation_space), "predict()'s input")
-        if deterministic and self.decoding == "expectation" and self.action_grid is not None:
+        if deterministic and self.decoding != "argmax" and self.action_grid is not None:
             return self._expected_action(observation), state
         actions, state = self.policy.predict(observation, state, episode_start, deterministic=True)
         if not deterministic:
@@ -498,16 +504,30 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
             )
         return self.to_env_action(actions), state
 
+    @property
+    def softmax_temperature(self) -> float:
+        """The temperature of a softmax decoding: ``decoding_temperature``, or the decoding's default when it is
+        ``None`` (:data:`~sb3_gqn.common.masking.DEFAULT_DECODING_TEMPERATURES`)."""
+        if self.decoding_temperature is not None:
+            return self.decoding_temperature
+        return DEFAULT_DECODING_TEMPERATURES.get(self.decoding, DEFAULT_DECODING_TEMPERATURES["expectation"])
+
     def _expected_action(self, observation: np.ndarray | dict[str, np.ndarray]) -> np.ndarray:
-        """``decoding="expectation"``: each dimension's expected bin value under the softmax of the acting
-        utilities over the deployed bins (:func:`~sb3_gqn.common.masking.masked_expectation`)."""
+        """``decoding="expectation"`` or ``"relative"``: each dimension's expected bin value under the softmax of the
+        acting utilities over the deployed bins (:func:`~sb3_gqn.common.masking.masked_expectation`)."""
         grid = self.action_grid
         assert grid is not None
         obs_tensor, vectorized = self.policy.obs_to_tensor(observation)
         with th.no_grad():
             utilities = self.policy.greedy_utilities(obs_tensor)
             bin_values = th.as_tensor(grid.values, device=utilities.device, dtype=utilities.dtype)
-            values = masked_expectation(utilities, self.policy.active_bins_mask, bin_values, self.decoding_temperature)
+            values = masked_expectation(
+                utilities,
+                self.policy.active_bins_mask,
+                bin_values,
+                self.softmax_temperature,
+                relative=self.decoding == "relative",
+            )
         actions = values.cpu().numpy().reshape((-1, *grid.box.shape)).astype(grid.box.dtype)
         return actions if vectorized else actions[0]
 
