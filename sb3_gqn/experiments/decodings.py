@@ -126,6 +126,7 @@ def compare_decodings(
                 "task_return": figures.task_return,
                 "smoothness": figures.smoothness,
                 "action_change": figures.action_change,
+                "success": figures.success,
             }
         )
     return rows
@@ -140,11 +141,16 @@ def main(argv: list[str] | None = None) -> int:
     import pandas as pd
 
     from sb3_gqn.common.envs import make_env
+    from sb3_gqn.experiments.variants import RunSpec, make_eval_env
+    from sb3_gqn.zoo.registration import register
 
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("models", nargs="+")
     parser.add_argument("--env", required=True)
     parser.add_argument("--penalty", type=float, default=0.1)
+    parser.add_argument(
+        "--algo", help="the runner agent that trained the models: read them on the runner's evaluation env (its wrappers)"
+    )
     parser.add_argument("--margins", type=float, nargs="*", default=[0.1, 0.3, 1.0, 3.0])
     parser.add_argument("--temperatures", type=float, nargs="*", default=[0.03, 0.1, 0.3, 1.0])
     parser.add_argument("--relative-temperatures", type=float, nargs="*", default=[])
@@ -153,7 +159,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     rows = []
     for path in args.models:
-        env = make_env(args.env, action_penalty=args.penalty)
+        if args.algo:
+            register()
+            env = make_eval_env(RunSpec(args.algo, args.env, args.penalty, 0, 1))
+        else:
+            env = make_env(args.env, action_penalty=args.penalty)
         model = GQN.load(path, env=env)
         decodings = [Decoding(model), *(Hysteresis(model, m) for m in args.margins)]
         decodings += [SoftmaxExpectation(model, t) for t in args.temperatures]
