@@ -58,7 +58,7 @@ def masked_argmax(q_values: th.Tensor, mask: th.Tensor) -> th.Tensor:
 DECODINGS = ("argmax", "expectation", "relative")
 
 #: the temperature each softmax decoding uses when none is given
-DEFAULT_DECODING_TEMPERATURES = {"expectation": 0.3, "relative": 0.3}
+DEFAULT_DECODING_TEMPERATURES = {"expectation": 0.3, "relative": 0.1}
 
 
 #: The decoding temperatures a float32 softmax can use: float32's positive normal numbers, from its smallest normal

@@ -157,8 +157,8 @@ class GQN(SavedFiles, GrowingResolution, OffPolicyAlgorithm):
         utilities' units (``"expectation"``) or relative to each state's spread of utilities, largest minus smallest
         per dimension (``"relative"``: the same temperature serves tasks whose rewards differ in scale). Training
         (exploration, growth's greedy episodes, the TD target) is unchanged
-    :param decoding_temperature: the softmax temperature; ``None``: the decoding's default (0.3 for both; towards 0
-        a softmax decoding is the greedy bin)
+    :param decoding_temperature: the softmax temperature; ``None``: the decoding's default (``"expectation"`` 0.3,
+        ``"relative"`` 0.1; towards 0 a softmax decoding is the greedy bin)
     :param precision: the arithmetic of the training updates' matrix products (:mod:`sb3_gqn.common.precision`):
         ``"fp32"`` (default); ``"bf16"``, bfloat16 operands with float32 accumulation, master weights, optimizer state,
         targets, loss and priorities (on bfloat16 kernels where the device has bfloat16 matrix units, elsewhere as the
