@@ -32,8 +32,8 @@ REPOSITORY = Path(__file__).resolve().parents[1]
 REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
 RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
 PLAIN_TORSO = "dict(layer_norm=False, activation_fn=nn.ReLU)"
-#: the paper as written, the research ablation's starting point
-BEFORE_GROWTH_FIXES = {
+#: the paper's growth as written, the ablation's starting point
+PAPER_AS_WRITTEN = {
     "growth": "adaptive",
     "growth_init": "none",
     "growth_patience": None,
@@ -130,8 +130,8 @@ def test_tiny_suite_end_to_end_and_resume(tmp_path, capsys):
 
 
 def test_a_committed_table_alone_resumes_and_accumulates(tmp_path, capsys):
-    # A later session has only the committed results.csv (runs/ is not in git): recorded runs are not retrained,
-    # and a new invocation with another algorithm adds its rows to the same table.
+    # A checkout has only the committed results.csv (runs/ is not in git): recorded runs are not retrained, and a
+    # new invocation with another algorithm adds its rows to the same table.
     out = tmp_path / "suite"
     assert main(["--algos", "decqn-2", *TINY, "--out", str(out), "--no-plots"]) == 0
     table = out / "results.csv"
@@ -183,9 +183,9 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
 
 
 def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each(research_variants):
-    assert research_variants["gqn-before"].hyperparams == BEFORE_GROWTH_FIXES
+    assert research_variants["gqn-before"].hyperparams == PAPER_AS_WRITTEN
     for name in ["gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared"]:
-        changed = {key for key, value in research_variants[name].hyperparams.items() if BEFORE_GROWTH_FIXES.get(key) != value}
+        changed = {key for key, value in research_variants[name].hyperparams.items() if PAPER_AS_WRITTEN.get(key) != value}
         assert (
             changed
             == {
@@ -214,7 +214,7 @@ def results_page():
 def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants(research_variants):
     """sb3_gqn.experiments.report's --shipped (and docs/results/build.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
-    residual torso, by rule R1; finger: DecQN's default torso)."""
+    residual torso; finger: DecQN's default torso)."""
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
     assert {walker: "+residual+1update", finger: "+layernorm+1update"} == results_page().SHIPPED
@@ -241,14 +241,13 @@ def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_v
         assert run_overrides(RunSpec.of("gqn-before", env, 0.1, 0, 1000, research_variants))[1] == {
             "train_freq": 2,
             "policy_kwargs": PLAIN_TORSO,
-            **BEFORE_GROWTH_FIXES,
+            **PAPER_AS_WRITTEN,
         }
 
 
 def test_the_torso_variants_differ_from_the_entries_only_in_the_torso(research_variants):
-    """Issue 11 item 5: walker's earlier entry (``+layernorm+1update``) and finger's residual candidate
-    (``+residual+1update``) each train the task's shipped entry with the other torso and nothing else changed, so
-    their runs compare with the shipped ones seed for seed."""
+    """Walker's ``+layernorm+1update`` and finger's ``+residual+1update`` each train the task's shipped entry with
+    the other torso and nothing else changed, so their runs compare with the shipped ones seed for seed."""
     walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         for env, other, torso in [
