@@ -139,6 +139,7 @@ def growth_checks(table: pd.DataFrame, variants: Mapping[str, Variant] = VARIANT
 
 
 def _markdown(frame: pd.DataFrame) -> str:
+    # Not DataFrame.to_markdown: it needs tabulate (no dependency here) and pads every cell to its column's width.
     header = "| " + " | ".join(str(column) for column in frame.columns) + " |"
     rule = "| " + " | ".join("---" for _ in frame.columns) + " |"
     rows = ["| " + " | ".join(_cell(value) for value in row) + " |" for row in frame.itertuples(index=False)]
