@@ -21,6 +21,7 @@ import importlib.abc
 import importlib.machinery
 import importlib.util
 import sys
+import threading
 import warnings
 from collections.abc import Iterator, Sequence
 from types import ModuleType
@@ -86,32 +87,48 @@ class MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
 #: true inside :func:`quiet_old_paths`
 _quiet: contextvars.ContextVar[bool] = contextvars.ContextVar("sb3_gqn_quiet_old_paths", default=False)
+#: how many :func:`quiet_old_paths` blocks are open (in any thread), and the old paths absent when one opened
+_open_blocks = 0
+_imported_quietly: set[str] = set()
+_blocks_lock = threading.Lock()
 
 
 @contextlib.contextmanager
 def quiet_old_paths() -> Iterator[None]:
     """Import the 0.1.0 module paths without a ``DeprecationWarning`` inside the block: for reading files saved by
     0.1.0 (models and replay buffers name their classes by module path), which a user cannot change. The old paths
-    first imported inside the block are dropped from ``sys.modules`` again at its end, so that a user's own import of
-    one afterwards still warns.
+    first imported inside the block are dropped from ``sys.modules`` again when the last open block (in any thread)
+    ends, so that a user's own import of one afterwards still warns.
 
     .. code-block:: python
 
         with quiet_old_paths():
             model = GQN.load("saved_by_0.1.0.zip")
     """
-    before = {name for name in MOVED_MODULES if name in sys.modules}
+    global _open_blocks
+    with _blocks_lock:
+        _open_blocks += 1
+        _imported_quietly.update(name for name in MOVED_MODULES if name not in sys.modules)
     token = _quiet.set(True)
     try:
         yield
     finally:
         _quiet.reset(token)
-        for name in MOVED_MODULES.keys() - before:
-            module = sys.modules.pop(name, None)
-            parent_name, _, child = name.rpartition(".")
-            parent = sys.modules.get(parent_name)
-            if module is not None and parent is not None and getattr(parent, child, None) is module:
-                delattr(parent, child)
+        with _blocks_lock:
+            _open_blocks -= 1
+            if _open_blocks == 0:  # another thread's block may still be reading a file that names them
+                for name in list(_imported_quietly):
+                    _drop(name)
+                _imported_quietly.clear()
+
+
+def _drop(name: str) -> None:
+    """Take the old path ``name`` out of ``sys.modules`` and off its parent package (the new module stays)."""
+    module = sys.modules.pop(name, None)
+    parent_name, _, child = name.rpartition(".")
+    parent = sys.modules.get(parent_name)
+    if module is not None and parent is not None and getattr(parent, child, None) is module:
+        delattr(parent, child)
 
 
 def install() -> None:
