@@ -112,13 +112,13 @@ def test_acting_tau_none_keeps_no_copy():
     model = GQN("MlpPolicy", "Pendulum-v1", acting_tau=None, **SMALL)
     assert len(model.policy.acting_q_nets) == 0
     assert not any(key.startswith("acting_q_nets") for key in model.policy.state_dict())
-    assert "averaged_acting" not in model.policy_kwargs  # such a model saves the policy_kwargs it did before D4
+    assert "averaged_acting" not in model.policy_kwargs  # the policy_kwargs of a model without averaged acting
     assert model.policy.acting_networks() == [model.q_net]
 
 
 @pytest.mark.parametrize("algorithm", [GQN, DecQN])
 def test_the_default_acts_on_the_average_at_0_001(algorithm):
-    model = algorithm("MlpPolicy", "Pendulum-v1", **SMALL)  # rule D4 made 0.001 the default of both agents
+    model = algorithm("MlpPolicy", "Pendulum-v1", **SMALL)  # 0.001 is the default of both agents
     assert model.acting_tau == 0.001
     assert model.policy.averaged_acting and len(model.policy.acting_q_nets) == 1
     assert model.policy.acting_networks() == [model.policy.acting_q_nets[0]]

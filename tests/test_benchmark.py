@@ -21,7 +21,6 @@ from sb3_gqn.experiments.variants import (
     VARIANTS,
     RunSpec,
     learning_starts,
-    load_variants,
     penalized_wrappers,
     run_overrides,
     untrained_runs,
@@ -30,13 +29,11 @@ from sb3_gqn.experiments.variants import (
 from sb3_gqn.zoo.hyperparams import shipped_entry
 
 REPOSITORY = Path(__file__).resolve().parents[1]
-RESEARCH_VARIANTS = REPOSITORY / "docs" / "research" / "variants.yml"
-load_variants(RESEARCH_VARIANTS)  # the research record's agents, which the committed tables hold
 REFERENCE_TORSO = "dict(layer_norm=True, activation_fn=nn.ELU)"
 RESIDUAL_TORSO = "dict(residual_layer_norm=True)"
 PLAIN_TORSO = "dict(layer_norm=False, activation_fn=nn.ReLU)"
-#: the paper as written, the research ablation's starting point
-BEFORE_GROWTH_FIXES = {
+#: the paper's growth as written, the ablation's starting point
+PAPER_AS_WRITTEN = {
     "growth": "adaptive",
     "growth_init": "none",
     "growth_patience": None,
@@ -133,8 +130,8 @@ def test_tiny_suite_end_to_end_and_resume(tmp_path, capsys):
 
 
 def test_a_committed_table_alone_resumes_and_accumulates(tmp_path, capsys):
-    # A later session has only the committed results.csv (runs/ is not in git): recorded runs are not retrained,
-    # and a new invocation with another algorithm adds its rows to the same table.
+    # A checkout has only the committed results.csv (runs/ is not in git): recorded runs are not retrained, and a
+    # new invocation with another algorithm adds its rows to the same table.
     out = tmp_path / "suite"
     assert main(["--algos", "decqn-2", *TINY, "--out", str(out), "--no-plots"]) == 0
     table = out / "results.csv"
@@ -185,10 +182,10 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
     assert not list(out.glob("*.tmp"))
 
 
-def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each():
-    assert VARIANTS["gqn-before"].hyperparams == BEFORE_GROWTH_FIXES
+def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each(research_variants):
+    assert research_variants["gqn-before"].hyperparams == PAPER_AS_WRITTEN
     for name in ["gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared"]:
-        changed = {key for key, value in VARIANTS[name].hyperparams.items() if BEFORE_GROWTH_FIXES.get(key) != value}
+        changed = {key for key, value in research_variants[name].hyperparams.items() if PAPER_AS_WRITTEN.get(key) != value}
         assert (
             changed
             == {
@@ -199,9 +196,10 @@ def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each()
         )
 
 
-def trained(algo: str, env: str) -> dict:
-    """The hyperparameters the runner trains ``algo`` with on ``env``: the shipped entry with the variant's overrides."""
-    zoo_algo, overrides = run_overrides(RunSpec(algo, env, 0.1, 0, 1000))
+def trained(algo: str, env: str, variants) -> dict:
+    """The hyperparameters the runner trains agent ``algo`` of ``variants`` with on ``env``: the shipped entry with the
+    variant's overrides."""
+    zoo_algo, overrides = run_overrides(RunSpec.of(algo, env, 0.1, 0, 1000, variants))
     return {**shipped_entry(zoo_algo, env), **overrides}
 
 
@@ -213,45 +211,50 @@ def results_page():
     return module
 
 
-def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants():
+def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants(research_variants):
     """sb3_gqn.experiments.report's --shipped (and docs/results/build.py) report these variants' walker and finger runs
     under the plain names: that holds only while they train exactly what the shipped entries train (walker: DecQN's
-    residual torso, by rule R1; finger: DecQN's default torso)."""
+    residual torso; finger: DecQN's default torso)."""
     walker, finger, cartpole = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0", "dm_control/cartpole-swingup-v0"
 
     assert {walker: "+residual+1update", finger: "+layernorm+1update"} == results_page().SHIPPED
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
-        assert trained(algo, walker) == trained(f"{algo}+residual+1update", walker)
-        assert trained(algo, finger) == trained(f"{algo}+layernorm+1update", finger)
-        assert trained(algo, walker)["policy_kwargs"] == RESIDUAL_TORSO
+        assert trained(algo, walker, research_variants) == trained(f"{algo}+residual+1update", walker, research_variants)
+        assert trained(algo, finger, research_variants) == trained(f"{algo}+layernorm+1update", finger, research_variants)
+        assert trained(algo, walker, research_variants)["policy_kwargs"] == RESIDUAL_TORSO
         for env in (walker, finger):
-            assert trained(algo, env)["train_freq"] == 1
+            assert trained(algo, env, research_variants)["train_freq"] == 1
         # cartpole (the main job) keeps the plain MLP and 1 update per 2 env steps
-        assert trained(algo, cartpole)["train_freq"] == 2 and trained(algo, cartpole)["policy_kwargs"] == PLAIN_TORSO
+        assert (
+            trained(algo, cartpole, research_variants)["train_freq"] == 2
+            and trained(algo, cartpole, research_variants)["policy_kwargs"] == PLAIN_TORSO
+        )
     # The torso-alone probes and the ablation keep what they were recorded with (1 update per 2 steps; the MLP torso)
     for algo in ("gqn-adaptive+layernorm", "decqn-9+layernorm"):
-        assert trained(algo, walker)["train_freq"] == 2 and trained(algo, walker)["policy_kwargs"] == REFERENCE_TORSO
+        assert (
+            trained(algo, walker, research_variants)["train_freq"] == 2
+            and trained(algo, walker, research_variants)["policy_kwargs"] == REFERENCE_TORSO
+        )
     for env in (walker, finger):
-        before = trained("gqn-before+shared", env)
+        before = trained("gqn-before+shared", env, research_variants)
         assert before["train_freq"] == 2 and before["policy_kwargs"] == PLAIN_TORSO and before["exploration"] == "shared"
-        assert run_overrides(RunSpec("gqn-before", env, 0.1, 0, 1000))[1] == {
+        assert run_overrides(RunSpec.of("gqn-before", env, 0.1, 0, 1000, research_variants))[1] == {
             "train_freq": 2,
             "policy_kwargs": PLAIN_TORSO,
-            **BEFORE_GROWTH_FIXES,
+            **PAPER_AS_WRITTEN,
         }
 
 
-def test_the_torso_variants_differ_from_the_entries_only_in_the_torso():
-    """Issue 11 item 5: walker's earlier entry (``+layernorm+1update``) and finger's residual candidate
-    (``+residual+1update``) each train the task's shipped entry with the other torso and nothing else changed, so
-    their runs compare with the shipped ones seed for seed."""
+def test_the_torso_variants_differ_from_the_entries_only_in_the_torso(research_variants):
+    """Walker's ``+layernorm+1update`` and finger's ``+residual+1update`` each train the task's shipped entry with
+    the other torso and nothing else changed, so their runs compare with the shipped ones seed for seed."""
     walker, finger = "dm_control/walker-walk-v0", "dm_control/finger-spin-v0"
     for algo in ("gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"):
         for env, other, torso in [
             (walker, "+layernorm+1update", REFERENCE_TORSO),
             (finger, "+residual+1update", RESIDUAL_TORSO),
         ]:
-            shipped, candidate = trained(algo, env), trained(f"{algo}{other}", env)
+            shipped, candidate = trained(algo, env, research_variants), trained(f"{algo}{other}", env, research_variants)
             assert {key for key in shipped | candidate if shipped.get(key) != candidate.get(key)} == {"policy_kwargs"}
             assert candidate["policy_kwargs"] == torso
 
@@ -315,12 +318,9 @@ def test_the_development_table_reads_the_final_evaluations_and_success(tmp_path)
 def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     """The README's, the results page's and the suite pages' generated tables are what docs/results/build.py makes of
     the committed results.csv files: a table extended without `make results-page` fails here."""
-    from sb3_gqn.experiments.variants import load_variants
-
     root = Path(__file__).parents[1]
     monkeypatch.chdir(root)
     page = results_page()
-    load_variants(page.RESEARCH_VARIANTS)
 
     def block(path, name):
         after_begin = path.read_text().split(f"<!-- BEGIN generated: {name} -->\n", 1)[1]
@@ -452,32 +452,54 @@ def test_the_local_runner_imports_no_ray():
     assert result.stdout.strip().splitlines()[-1] == "False"
 
 
-def test_warm_started_is_every_variant_but_the_cold_ablation():
-    assert not warm_started("gqn-before") and not warm_started("gqn-before+plateau")
-    assert not warm_started("gqn-before+shared")
-    assert warm_started("gqn-before+warm-start") and warm_started("gqn-adaptive") and warm_started("gqn-linear")
-    assert warm_started("gqn-adaptive+residual+1update")
-    assert warm_started("a-table-from-elsewhere")  # the class default
+def test_warm_started_is_every_variant_but_the_cold_ablation(research_variants):
+    def warm(algo):
+        return warm_started(algo, research_variants)
+
+    assert not warm("gqn-before") and not warm("gqn-before+plateau") and not warm("gqn-before+shared")
+    assert warm("gqn-before+warm-start") and warm("gqn-adaptive") and warm("gqn-linear")
+    assert warm("gqn-adaptive+residual+1update")
+    assert warm("a-table-from-elsewhere")  # the class default
+    assert warm_started("gqn-before")  # an agent of a variants file is known only where its agents are passed
 
 
-def test_two_critics_keep_the_entry_torso():
+def test_loading_a_variants_file_changes_nothing_global(tmp_path):
+    from sb3_gqn.experiments.variants import load_variants, with_variants_files
+
+    shipped = dict(VARIANTS)
+    (tmp_path / "variants.yml").write_text("gqn-cold:\n  algo: gqn\n  hyperparams: {growth_init: none}\n")
+    loaded = load_variants(tmp_path / "variants.yml")
+    assert list(loaded) == ["gqn-cold"] and dict(VARIANTS) == shipped
+    agents = with_variants_files([tmp_path / "variants.yml"])
+    assert list(agents) == [*shipped, "gqn-cold"] and dict(VARIANTS) == shipped
+    with pytest.raises(TypeError):
+        VARIANTS["gqn-cold"] = loaded["gqn-cold"]  # read-only
+    with pytest.raises(ValueError, match="Unknown agent 'gqn-cold'"):
+        RunSpec("gqn-cold", "Pendulum-v1", 0.1, 0, 400)
+    assert RunSpec.of("gqn-cold", "Pendulum-v1", 0.1, 0, 400, agents).variant == loaded["gqn-cold"]
+    with pytest.raises(ValueError, match="redefines an agent"):
+        (tmp_path / "again.yml").write_text("gqn-cold:\n  algo: gqn\n  hyperparams: {growth_init: interpolate}\n")
+        with_variants_files([tmp_path / "variants.yml", tmp_path / "again.yml"])
+
+
+def test_two_critics_keep_the_entry_torso(research_variants):
     """``gqn-adaptive+twin`` adds DecQN's second critic to the entry's own torso (walker's residual one: the reference
     as its experiments run it), not in place of it."""
     from sb3_gqn.experiments.variants import added_policy_kwargs
 
-    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
+    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0", research_variants)["policy_kwargs"] == (
         "dict(residual_layer_norm=True, n_critics=2)"
     )
-    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0")["train_freq"] == 1
+    assert trained("gqn-adaptive+twin", "dm_control/walker-walk-v0", research_variants)["train_freq"] == 1
     # cartpole's entry pins the plain MLP its recorded twin runs trained
-    assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0")["policy_kwargs"] == (
+    assert trained("gqn-adaptive+twin", "dm_control/cartpole-swingup-v0", research_variants)["policy_kwargs"] == (
         "dict(layer_norm=False, activation_fn=nn.ReLU, n_critics=2)"
     )
     # decqn-9's twin keeps decqn.yml's entry (finger's DecQN default torso) at 9 bins
-    finger_decqn = trained("decqn-9+twin", "dm_control/finger-spin-v0")
+    finger_decqn = trained("decqn-9+twin", "dm_control/finger-spin-v0", research_variants)
     assert finger_decqn["policy_kwargs"] == "dict(layer_norm=True, activation_fn=nn.ELU, n_critics=2)"
     assert finger_decqn["bins"] == 9 and finger_decqn["train_freq"] == 1
-    assert trained("decqn-9+twin", "dm_control/walker-walk-v0")["policy_kwargs"] == (
+    assert trained("decqn-9+twin", "dm_control/walker-walk-v0", research_variants)["policy_kwargs"] == (
         "dict(residual_layer_norm=True, n_critics=2)"
     )
     assert added_policy_kwargs("dict()", "n_critics=2") == "dict(n_critics=2)"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 
 from sb3_gqn.experiments.report import as_shipped, growth_checks, held_after_growth, main, report, select
-from sb3_gqn.experiments.variants import load_variants
+from sb3_gqn.experiments.variants import with_variants_files
 
 
 def test_held_after_growth_hand_values():
@@ -38,9 +38,9 @@ def _row(algo, seed, step, value, events="", env="dm_control/cartpole-swingup-v0
 
 
 def test_growth_checks_pair_each_event_with_the_evaluations_around_it(tmp_path):
-    # the cold-start agent below, defined here so that the test does not depend on another test loading it
+    # the cold-start agent below, passed to the check with the shipped ones
     (tmp_path / "variants.yml").write_text("gqn-cold:\n  algo: gqn\n  hyperparams: {growth_init: none}\n")
-    load_variants(tmp_path / "variants.yml")
+    variants = with_variants_files([tmp_path / "variants.yml"])
     table = pd.DataFrame(
         [
             _row("gqn-adaptive", 0, 10_000, 400.0, "8000:3"),
@@ -74,7 +74,7 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it(tmp_path):
     )
     # Without a warm start the untrained bins act at once: that evaluation is "after"
     cold = linear.assign(algo="gqn-cold")
-    [check] = growth_checks(cold)
+    [check] = growth_checks(cold, variants)
     assert (check.before_step, check.before, check.after_step, check.after, check.held) == (
         10_000,
         300.0,
@@ -82,6 +82,8 @@ def test_growth_checks_pair_each_event_with_the_evaluations_around_it(tmp_path):
         280.0,
         True,  # 280 >= 0.7 * 300 = 210
     )
+    [check] = growth_checks(cold)  # without the file, gqn-cold is an unknown name: counted as warm-started
+    assert (check.before_step, check.after_step) == (20_000, 30_000)
     text = report(table, reps=50)
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 30000 | 200 |" in text
     assert "| cartpole-swingup-v0 | gqn-adaptive | 0 | 25000 -> 9 | 500 (20000) | 200 (30000) | **no** |" in text

@@ -78,6 +78,13 @@ def test_a_dict_observation_gqn_keeps_its_adaptive_schedule():
     assert type(model.replay_buffer) is PrioritizedDictReplayBuffer
 
 
+def run_python(code: str) -> str:
+    """Run ``code`` in a fresh interpreter (imports and reloads stay out of this one); its stdout."""
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    return result.stdout.strip()
+
+
 @pytest.mark.parametrize(
     ("old", "new"),
     [
@@ -88,11 +95,62 @@ def test_a_dict_observation_gqn_keeps_its_adaptive_schedule():
         ("sb3_gqn.metrics", "sb3_gqn.common.smoothness"),
     ],
 )
-def test_the_0_1_0_module_paths_are_the_new_modules(old, new):
-    code = f"import {old}, {new}, sys; print(sys.modules['{old}'] is sys.modules['{new}'])"
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "True"
+def test_the_0_1_0_module_paths_are_the_new_modules_and_warn(old, new):
+    code = f"""
+import sys, warnings
+import {new}
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    import {old}
+print(sys.modules["{old}"] is sys.modules["{new}"], sys.modules["{new}"].__spec__.name)
+print("|".join(f"{{w.category.__name__}}:{{w.filename}}:{{w.message}}" for w in caught))
+"""
+    identity, warned = run_python(code).splitlines()
+    assert identity == f"True {new}"  # the new module keeps its own spec
+    category, filename, message = warned.split(":", 2)
+    assert category == "DeprecationWarning" and filename == "<string>"  # the warning names the importing line
+    assert f"import {new} instead" in message and "removed in sb3-gqn 1.0.0" in message
+
+
+def test_reloading_a_module_imported_by_its_0_1_0_path_reruns_its_source():
+    code = """
+import importlib, sys, warnings
+warnings.simplefilter("ignore", DeprecationWarning)
+import sb3_gqn.buffers
+import sb3_gqn.common.buffers as buffers
+del buffers.PrioritizedReplayBuffer
+importlib.reload(buffers)
+print(hasattr(buffers, "PrioritizedReplayBuffer"), buffers.__spec__.name, sys.modules["sb3_gqn.buffers"] is buffers)
+"""
+    assert run_python(code) == "True sb3_gqn.common.buffers True"
+
+
+def test_loading_files_saved_by_0_1_0_inside_quiet_old_paths_does_not_warn():
+    code = f"""
+import sys, warnings
+import gymnasium as gym
+from sb3_gqn import GQN, DecQN
+from sb3_gqn.common.module_aliases import MOVED_MODULES, quiet_old_paths
+fixtures = {str(FIXTURES)!r}
+sys.path.insert(0, fixtures)
+from make_fixtures import DictPendulum
+with warnings.catch_warnings():
+    warnings.simplefilter("error")
+    with quiet_old_paths():
+        for algo, name, env in [
+            (GQN, "gqn_linear_pendulum", gym.make("Pendulum-v1")),
+            (GQN, "gqn_adaptive_dict_pendulum", DictPendulum(gym.make("Pendulum-v1"))),
+            (DecQN, "decqn3_pendulum", gym.make("Pendulum-v1")),
+        ]:
+            model = algo.load(f"{{fixtures}}/{{name}}.zip", env=env)
+            model.load_replay_buffer(f"{{fixtures}}/{{name}}_buffer.pkl")
+print(sorted(set(MOVED_MODULES) & set(sys.modules)))  # what the files named is dropped again
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    import sb3_gqn.policies  # so a user's import of an old path still warns
+print([w.category.__name__ for w in caught])
+"""
+    assert run_python(code).splitlines() == ["[]", "['DeprecationWarning']"]
 
 
 def test_an_unknown_module_path_still_fails():

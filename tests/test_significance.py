@@ -76,6 +76,7 @@ def test_pooled_iqm_interval_resamples_within_each_task():
     spread = pooled_iqm_interval([np.arange(4.0), np.arange(4.0, 8.0)], reps=300)
     assert spread[1][0] < spread[0] < spread[1][1]
     assert pooled_iqm_interval([np.arange(4.0), np.arange(4.0, 8.0)], reps=300) == spread  # seeded
+    assert pooled_iqm_interval([np.array([1.0]), np.array([2.0])]) == (1.5, (1.5, 1.5))  # nothing to resample
     with pytest.raises(ValueError, match="every task"):
         pooled_iqm_interval([np.arange(4.0), np.array([])])
 

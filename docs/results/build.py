@@ -13,76 +13,58 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
 from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
 from sb3_gqn.experiments.scores import final_rows
 from sb3_gqn.experiments.significance import difference_interval, mean_difference, mean_interval
-from sb3_gqn.experiments.variants import load_variants
+from sb3_gqn.experiments.variants import Variant, with_variants_files
 
 RESULTS = Path("docs/results")
 PAGE = RESULTS / "README.md"
 README = Path("README.md")
-#: The tables hold the research record's agents too (their names are in the variants file)
-RESEARCH_VARIANTS = Path("docs/research/variants.yml")
-#: The entries (gqn.yml, decqn.yml) a task has shipped, oldest first, each as the runner's variant suffix that trains
-#: exactly it ("" = the plain names); the last is the shipped one. Tasks not listed have shipped one entry.
-ENTRIES = {
-    "dm_control/walker-walk-v0": ["", "+layernorm+1update", "+residual+1update"],
-    "dm_control/finger-spin-v0": ["", "+layernorm+1update"],
-}
+#: What the pages show (tables, agents, labels, comparisons): the research record's choices, read from this file
+CHOICES = Path(__file__).resolve().parents[1] / "research" / "results-page.yml"
+_CHOICES = yaml.safe_load(CHOICES.read_text())
+#: The agents the tables hold beyond the shipped ones (a variants file)
+RESEARCH_VARIANTS = Path(_CHOICES["variants"])
+#: task -> the entries it has shipped, oldest first, as the runner's variant suffix that trains each ("" = the plain
+#: names); the last is the shipped one
+ENTRIES: dict[str, list[str]] = _CHOICES["main"]["entries"]
 SHIPPED = {env: entries[-1] for env, entries in ENTRIES.items()}
-MAIN_ALGOS = ["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9"]
-BASELINES = ["sac"]
-#: how far gqn-adaptive and gqn-linear are ahead of the static baselines, across tasks and per task; SAC per task
-MAIN_PAIRS = [
-    ("gqn-adaptive", "decqn-9"),
-    ("gqn-adaptive", "decqn-2"),
-    ("gqn-linear", "decqn-9"),
-    ("gqn-adaptive", "gqn-linear"),
-]
-BASELINE_PAIRS = [("gqn-adaptive", "sac"), ("gqn-linear", "sac"), ("decqn-9", "sac")]
-MAIN_TABLES = ["cartpole-swingup_c0.1_100k", "finger-spin_c0.1_100k", "walker-walk_c0.1_100k", "walker-walk_c0.1_100k_torso"]
-#: the IQM reads 8 runs per agent and task, each agent's lowest seeds (0-7); the "every run" columns pool them all
-IQM_RUNS = 8
-#: The development suite the class defaults were chosen on (docs/research/defaults.md): its agents, as the README names
-#: them. On its tasks, the first trains what GQN's defaults (and the entries without tuned settings) train now.
-DEVELOPMENT = RESULTS / "development" / "results.csv"
-DEVELOPMENT_AGENTS = {
-    "gqn-adaptive+layernorm+1update+bins3-9": "GQN (defaults)",
-    "decqn-9+layernorm+1update": "DecQN-9",
-    "decqn-2+layernorm+1update": "DecQN-2",
-    "sac": "SAC",
-    "gqn-adaptive-0.2": "GQN (0.2.0 defaults)",
-}
+MAIN_ALGOS: list[str] = _CHOICES["main"]["agents"]
+BASELINES: list[str] = _CHOICES["main"]["baselines"]
+#: the comparisons across tasks and per task; BASELINE_PAIRS per task only
+MAIN_PAIRS = [(a, b) for a, b in _CHOICES["main"]["pairs"]]
+BASELINE_PAIRS = [(a, b) for a, b in _CHOICES["main"]["baseline_pairs"]]
+MAIN_TABLES: list[str] = _CHOICES["main"]["tables"]
+#: the IQM's runs per agent and task (each agent's lowest seeds); the "every run" columns pool them all
+IQM_RUNS = int(_CHOICES["main"]["iqm_runs"])
+#: the development suite's table and its agents (runner name: label)
+DEVELOPMENT = Path(_CHOICES["development"]["table"])
+DEVELOPMENT_AGENTS: dict[str, str] = _CHOICES["development"]["agents"]
+#: the smooth-control runs: the remedies (runner name: label; the first is the decoding remedy, whose final models
+#: ``decodings-<task>.csv`` reads with each decoding of SMOOTH_DECODINGS), and the goal (SM at most this multiple of
+#: SAC's)
+SMOOTH_CONTROL = Path(_CHOICES["smooth_control"]["folder"])
+SMOOTH_REMEDIES: dict[str, str] = _CHOICES["smooth_control"]["remedies"]
+SMOOTH_REMEDY, SMOOTH_RATE = list(SMOOTH_REMEDIES)
+SMOOTH_DECODINGS: dict[str, str] = _CHOICES["smooth_control"]["decodings"]
+SMOOTHNESS_GOAL = float(_CHOICES["smooth_control"]["smoothness_goal"])
+#: page name -> the runner's output folder and the agents shown (runner name: label); each page
+#: ``docs/results/<name>.md`` gets its table and the curves once the folder's ``results.csv`` exists
+SUITES = {name: (Path(suite["folder"]), dict(suite["agents"])) for name, suite in _CHOICES["suites"].items()}
 
 
-#: The smooth-control evidence (docs/research/smooth-control.md): the runner's runs of the remedy, and every final model
-#: of them read with the greedy argmax and with the remedy's decoding (``python -m sb3_gqn.experiments.decodings
-#: ... --csv decodings-<task>.csv``), so the two decodings compare on the same models
-SMOOTH_CONTROL = RESULTS / "smooth-control"
-SMOOTH_REMEDY = "gqn-adaptive+expectation0.3"
-#: the second remedy, measured when the decoding missed the goal: the action-rate penalty in training (argmax decoding)
-SMOOTH_RATE = "gqn-adaptive+rate0.3"
-SMOOTH_REMEDIES = {SMOOTH_REMEDY: "expectation 0.3", SMOOTH_RATE: "rate penalty 0.3"}
-SMOOTH_DECODINGS = {"greedy": "argmax", "softmax 0.3": "expectation 0.3"}
-#: the goal: SM at most this multiple of SAC's
-SMOOTHNESS_GOAL = 1.5
-
-#: The paper's other benchmarks (docs/research/benchmarks.md): page name -> the runner's output folder and the agents
-#: shown (runner name: label); each page ``docs/results/<name>.md`` gets its table and the curves once the folder's
-#: ``results.csv`` exists
-SUITES = {
-    "metaworld": (
-        RESULTS / "metaworld_c0.5_50k",
-        {"gqn-adaptive": "GQN 9 -> 65", "gqn-adaptive+from2": "GQN 2 -> 9", "decqn-9": "DecQN-9", "sac": "SAC"},
-    ),
-    "myosuite": (RESULTS / "myosuite", {"gqn-adaptive": "GQN", "decqn-9": "DecQN-9", "sac": "SAC"}),
-}
+def research_variants() -> dict[str, Variant]:
+    """The shipped agents and the research record's (:data:`RESEARCH_VARIANTS`), by name."""
+    return with_variants_files([RESEARCH_VARIANTS])
 
 
 def task_name(env: str) -> str:
@@ -142,9 +124,10 @@ def smooth_control_runs(path: Path = SMOOTH_CONTROL) -> pd.DataFrame:
     return table[table["algo"] == SMOOTH_REMEDY]
 
 
-def main_block(table: pd.DataFrame, remedy: pd.DataFrame | None = None) -> str:
+def main_block(table: pd.DataFrame, remedy: pd.DataFrame | None = None, variants: Mapping[str, Variant] | None = None) -> str:
     """The results page's tables, and the figures drawn into ``docs/results/main`` (the radars also show the
-    smooth-control ``remedy``'s runs)."""
+    smooth-control ``remedy``'s runs); ``variants``: the agents the tables hold (default: :func:`research_variants`)."""
+    variants = research_variants() if variants is None else variants
     main = table[table["algo"].isin(MAIN_ALGOS)]
     # Curves and radars show SAC where it ran; the IQM figure normalizes over the same runs as the IQM table
     learning_curves(table, RESULTS / "main")
@@ -152,7 +135,7 @@ def main_block(table: pd.DataFrame, remedy: pd.DataFrame | None = None) -> str:
     baselines = {agent: "a baseline: the IQM compares GQN with DecQN; its returns are in the task table and the curves"
                  for agent in BASELINES if agent in set(table["algo"])}  # fmt: skip
     aggregate(main, RESULTS / "main", max_runs=IQM_RUNS, left_out=baselines)
-    iqm = report_sections(main, reps=2000, max_runs=IQM_RUNS)["iqm"]
+    iqm = report_sections(main, reps=2000, max_runs=IQM_RUNS, variants=variants)["iqm"]
     across = comparisons_across_tasks(main, MAIN_PAIRS, reps=2000, max_runs=IQM_RUNS)
     per_task = comparisons_per_task(table, [*MAIN_PAIRS, *BASELINE_PAIRS], reps=2000)
     assert across is not None and per_task is not None, "the main tables hold every pair on every task"
@@ -371,10 +354,9 @@ def replace_block(path: Path, name: str, body: str) -> None:
 
 
 def run() -> int:
-    load_variants(RESEARCH_VARIANTS)
     table = comparison_table()
     remedy = smooth_control_runs()
-    replace_block(PAGE, "main", main_block(table, remedy))
+    replace_block(PAGE, "main", main_block(table, remedy, research_variants()))
     if len(remedy):
         replace_block(PAGE, "smooth-control", smooth_control_block(table))
     replace_block(README, "results", task_table(table))

@@ -259,22 +259,25 @@ def aggregate(
     covered = {str(algo): len(set(zip(runs["env"], runs["penalty"]))) for algo, runs in final_rows(table).groupby("algo")}
     reasons = {algo: f"runs on {count} of {len(tasks)} tasks" for algo, count in covered.items()}
     note = left_out_note([*covered, *(left_out or {})], list(scores), {**reasons, **(left_out or {})})
+    from rliable import plot_utils
+
     algos = sorted(scores, key=lambda algo: estimates[algo][0])
-    figure, axis = plt.subplots(figsize=(6, 0.6 * len(algos) + 1.2))
-    colors = agent_colors(sorted(algos))
+    figure, axis = plot_utils.plot_interval_estimates(
+        estimates, intervals, ["IQM"], algorithms=algos, colors=agent_colors(sorted(algos)), xlabel=""
+    )
+    for text in list(figure.texts):  # rliable's x label, placed below the canvas: the axis label says it instead
+        text.remove()
+    figure.set_size_inches(6, 0.6 * len(algos) + 1.2)
     for row, algo in enumerate(algos):
-        low, high = intervals[algo][:, 0]
-        axis.barh(row, high - low, left=low, height=0.6, alpha=0.6, color=colors[algo])
-        axis.plot([estimates[algo][0]] * 2, [row - 0.3, row + 0.3], color="black")
-        runs = int(scores[algo].shape[0])
-        if runs == 1:  # one run per task: no interval to draw, say so instead of showing an empty row
+        if int(scores[algo].shape[0]) == 1:  # one run per task: no interval to draw, say so instead of an empty row
+            high = intervals[algo][1, 0]
             axis.annotate(
                 "1 run per task: no CI", (high, row), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7
             )
     lows = [intervals[algo][0, 0] for algo in algos]
     highs = [intervals[algo][1, 0] for algo in algos]
     axis.set_xlim(min(lows) - 0.05, max(highs) + 0.2)  # room for the estimate at an interval's edge and the note
-    axis.set_yticks(range(len(algos)), algos)
+    axis.tick_params(labelsize=9)
     axis.set_xlabel("IQM of normalized final return (95 % bootstrap CI)")
     names = [f"{env.replace('dm_control/', '')} c={c:g}" for env, c in tasks]
     axis.set_title(f"{len(tasks)} task{'s' if len(tasks) != 1 else ''}: " + textwrap.fill(", ".join(names), 90), fontsize=8)

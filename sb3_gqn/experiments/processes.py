@@ -15,7 +15,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Hashable, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from types import FrameType
 from typing import Any
 
@@ -60,15 +60,17 @@ def run_in_processes(
         futures: dict[Future, Hashable] = {pool.submit(function, *args): key for key, function, args in calls}
         last_report = time.monotonic()
         while futures:
-            for future in [future for future in futures if future.done()]:
+            # blocks until a call finishes or the next report is due (a signal's KeyboardInterrupt still ends it)
+            timeout = None if on_wait is None else max(0.0, last_report + report_every - time.monotonic())
+            done, _ = wait(futures, timeout=timeout, return_when=FIRST_COMPLETED)
+            for future in [future for future in futures if future in done]:  # in the order of the calls
                 key = futures.pop(future)
                 future.result()  # a failed call stops the suite with its error
                 if on_finished is not None:
                     on_finished(key)
-            if on_wait is not None and futures and time.monotonic() - last_report > report_every:
+            if on_wait is not None and futures and time.monotonic() - last_report >= report_every:
                 on_wait(list(futures.values()))
                 last_report = time.monotonic()
-            time.sleep(0.2)
     except BaseException:
         pool.shutdown(wait=False, cancel_futures=True)
         _terminate_children()

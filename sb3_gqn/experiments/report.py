@@ -25,7 +25,7 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,7 +50,7 @@ from sb3_gqn.experiments.significance import (
     probability_of_improvement,
     seeds_to_resolve,
 )
-from sb3_gqn.experiments.variants import load_variants, warm_started
+from sb3_gqn.experiments.variants import VARIANTS, Variant, load_variants, warm_started, with_variants_files
 
 
 def held_after_growth(before: float, after: float) -> bool:
@@ -83,17 +83,20 @@ class GrowthCheck:
         return held_after_growth(self.before, self.after)
 
 
-def evaluations_around(steps: np.ndarray, growth_step: int, algo: str) -> tuple[np.ndarray, np.ndarray]:
+def evaluations_around(
+    steps: np.ndarray, growth_step: int, algo: str, variants: Mapping[str, Variant] = VARIANTS
+) -> tuple[np.ndarray, np.ndarray]:
     """Indices into ``steps`` (a run's evaluation steps, sorted) of the evaluations of the policy before a growth at
-    ``growth_step`` and of those the growth can have changed, for runner variant ``algo`` (see growth_checks)."""
-    if warm_started(algo):  # the evaluation at the growth step still acts as the level before
+    ``growth_step`` and of those the growth can have changed, for agent ``algo`` of ``variants`` (see growth_checks)."""
+    if warm_started(algo, variants):  # the evaluation at the growth step still acts as the level before
         return np.flatnonzero(steps <= growth_step), np.flatnonzero(steps > growth_step)
     return np.flatnonzero(steps < growth_step), np.flatnonzero(steps >= growth_step)
 
 
-def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
+def growth_checks(table: pd.DataFrame, variants: Mapping[str, Variant] = VARIANTS) -> list[GrowthCheck]:
     """Every growth event of every run in ``table`` with the last evaluation of the policy before it and the first
-    evaluation after it that the growth can have changed.
+    evaluation after it that the growth can have changed. ``variants``: the agents the table's runs trained (default:
+    the shipped ones; :func:`~sb3_gqn.experiments.variants.with_variants_files` adds those of variants files).
 
     An evaluation at the very step of a growth runs after it (the growth callback runs before every other callback
     of that step) and with the new bins. With a warm start (:func:`~sb3_gqn.experiments.variants.warm_started`) each opened
@@ -118,7 +121,7 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
             if on_probation:  # the evaluated policy changed at the deployment: an evaluation at that step acts on it
                 earlier, later = np.flatnonzero(steps < step), np.flatnonzero(steps >= step)
             else:
-                earlier, later = evaluations_around(steps, step, str(algo))
+                earlier, later = evaluations_around(steps, step, str(algo), variants)
             checks.append(
                 GrowthCheck(
                     str(algo),
@@ -136,6 +139,7 @@ def growth_checks(table: pd.DataFrame) -> list[GrowthCheck]:
 
 
 def _markdown(frame: pd.DataFrame) -> str:
+    # Not DataFrame.to_markdown: it needs tabulate (no dependency here) and pads every cell to its column's width.
     header = "| " + " | ".join(str(column) for column in frame.columns) + " |"
     rule = "| " + " | ".join("---" for _ in frame.columns) + " |"
     rows = ["| " + " | ".join(_cell(value) for value in row) + " |" for row in frame.itertuples(index=False)]
@@ -292,11 +296,16 @@ def comparison_sections(
 
 
 def report_sections(
-    table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None, max_runs: int | None = None
+    table: pd.DataFrame,
+    reps: int = 2000,
+    pairs: list[tuple[str, str]] | None = None,
+    max_runs: int | None = None,
+    variants: Mapping[str, Variant] = VARIANTS,
 ) -> dict[str, Section]:
     """The report's tables by key: ``final``, ``means``, then ``growth`` (GQN runs only), ``iqm`` (two tasks
     or more) and, for ``pairs``, ``comparison_tasks`` and ``comparison_per_task`` where the table has them.
-    ``max_runs`` caps the IQM's runs per task and agent (its lowest seeds); the "every run" columns pool them all."""
+    ``max_runs`` caps the IQM's runs per task and agent (its lowest seeds); the "every run" columns pool them all.
+    ``variants``: the agents the table's runs trained (:func:`growth_checks`)."""
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
     sections: dict[str, Section] = {}
     columns = {
@@ -324,7 +333,7 @@ def report_sections(
     means["env"] = means["env"].str.replace("dm_control/", "", regex=False)
     sections["means"] = Section("Mean over seeds", _markdown(means))
 
-    checks = growth_checks(table)
+    checks = growth_checks(table, variants)
     if checks:
         rows = [
             {
@@ -375,9 +384,14 @@ def report_sections(
     return sections
 
 
-def report(table: pd.DataFrame, reps: int = 2000, pairs: list[tuple[str, str]] | None = None) -> str:
-    """All tables as one markdown text."""
-    sections = report_sections(table, reps, pairs).values()
+def report(
+    table: pd.DataFrame,
+    reps: int = 2000,
+    pairs: list[tuple[str, str]] | None = None,
+    variants: Mapping[str, Variant] = VARIANTS,
+) -> str:
+    """All tables as one markdown text (``variants``: the agents the table's runs trained, :func:`growth_checks`)."""
+    sections = report_sections(table, reps, pairs, variants=variants).values()
     return "\n\n".join(f"### {section.heading}\n\n{section.body}" for section in sections) + "\n"
 
 
@@ -439,9 +453,10 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
         "across tasks, per task the differences of mean return and SM, with 95 %% bootstrap intervals",
     )
     args = parser.parse_args(argv)
+    variants = with_variants_files()
     for path in args.variants:
         try:
-            load_variants(path)
+            variants.update(load_variants(path, variants))
         except (OSError, ValueError, yaml.YAMLError) as error:
             parser.error(f"--variants {path}: {type(error).__name__}: {error}")
     if args.reps < 1:
@@ -477,7 +492,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn report") -> int
     if unknown:
         print(f"{prog}: error: no runs of {', '.join(unknown)} to compare", file=sys.stderr)
         return 2
-    print(report(table, args.reps, pairs))
+    print(report(table, args.reps, pairs, variants))
     if args.plots is not None:
         for path in plot_table(table, args.plots):
             print(f"plot: {path}")

@@ -43,7 +43,7 @@ from sb3_gqn.experiments.runs import (
     run,
     runs_in_progress,
 )
-from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, VARIANTS, RunSpec, load_variants, untrained_runs
+from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, RunSpec, load_variants, untrained_runs, with_variants_files
 from sb3_gqn.zoo.hyperparams import penalized_env_ids
 
 
@@ -59,9 +59,10 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
         "ones, e.g. docs/research/variants.yml",
     )
     known, _ = variants_parser.parse_known_args(argv)
+    agents = with_variants_files()  # the shipped agents, then each file's
     for path in known.variants:
         try:
-            load_variants(path)
+            agents.update(load_variants(path, agents))
         except (OSError, ValueError, yaml.YAMLError) as error:  # a missing, unreadable or malformed file
             argparse.ArgumentParser(prog=prog).error(f"--variants {path}: {type(error).__name__}: {error}")
     parser = argparse.ArgumentParser(
@@ -70,9 +71,9 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument(
         "--algos",
         nargs="+",
-        choices=list(VARIANTS),
+        choices=list(agents),
         metavar="AGENT",
-        help=f"agents: {', '.join(VARIANTS)} (default: {' '.join(SHORT_SUITE['algos'])})",
+        help=f"agents: {', '.join(agents)} (default: {' '.join(SHORT_SUITE['algos'])})",
     )
     parser.add_argument("--envs", nargs="+", help=f"env ids with an entry in the shipped files; default {SHORT_SUITE['envs']}")
     parser.add_argument("--penalties", nargs="+", type=float, help="action penalty coefficients c")
@@ -111,6 +112,7 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument("--list", action="store_true", help="list the runs and their state, train nothing")
     parser.add_argument("--no-plots", action="store_true")
     args = parser.parse_args(argv)
+    args.agents = agents  # the shipped agents and the variants files', by name
     defaults = FULL_SUITE if args.full else SHORT_SUITE
     for key in ("algos", "envs", "penalties", "seeds", "steps"):
         if getattr(args, key) is None:
@@ -166,7 +168,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
         return 2
     out = Path(args.out)
     specs = [
-        RunSpec(algo, env, penalty, seed, args.steps)
+        RunSpec.of(algo, env, penalty, seed, args.steps, args.agents)
         for env in args.envs
         for penalty in args.penalties
         for algo in args.algos

@@ -98,13 +98,17 @@ def difference_interval(
 
 def mean_interval(values: np.ndarray, reps: int = 2000, seed: int = 0) -> tuple[float, tuple[float, float]]:
     """The mean of one agent's runs on one task and its 95 % percentile bootstrap interval (runs resampled with
-    replacement); ``seed`` fixes the draws. One run gives no interval (NaN bounds); equal runs give the value itself."""
+    replacement; ``scipy.stats.bootstrap``); ``seed`` fixes the draws. One run gives no interval (NaN bounds); equal
+    runs give the value itself."""
+    from scipy.stats import bootstrap
+
     values = np.ravel(np.asarray(values, dtype=np.float64))
     if len(values) < 2:
         return float(values.mean()), (math.nan, math.nan)
-    rng = np.random.default_rng(seed)
-    replicates = rng.choice(values, size=(reps, len(values))).mean(axis=1)
-    low, high = np.percentile(replicates, [2.5, 97.5])
+    result = bootstrap(
+        (values,), np.mean, n_resamples=reps, vectorized=True, method="percentile", rng=np.random.default_rng(seed)
+    )
+    low, high = result.confidence_interval
     return float(values.mean()), (float(low), float(high))
 
 
@@ -121,14 +125,28 @@ def pooled_iqm(per_task: list[np.ndarray]) -> float:
 
 def pooled_iqm_interval(per_task: list[np.ndarray], reps: int = 2000, seed: int = 0) -> tuple[float, tuple[float, float]]:
     """:func:`pooled_iqm` and its 95 % percentile bootstrap interval, resampling each task's runs with replacement
-    within the task (stratified, as rliable's bootstrap; each task keeps its run count); ``seed`` fixes the draws."""
+    within the task (stratified, as rliable's bootstrap; each task keeps its run count): ``scipy.stats.bootstrap``
+    with one sample per task; ``seed`` fixes the draws."""
+    from scipy.stats import bootstrap, trim_mean
+
     per_task = [np.ravel(np.asarray(runs, dtype=np.float64)) for runs in per_task]
     if min(len(runs) for runs in per_task) < 1:
         raise ValueError("pooled_iqm_interval needs at least one run on every task")
-    rng = np.random.default_rng(seed)
-    replicates = [pooled_iqm([rng.choice(runs, size=len(runs)) for runs in per_task]) for _ in range(reps)]
-    low, high = np.percentile(replicates, [2.5, 97.5])
-    return pooled_iqm(per_task), (float(low), float(high))
+    value = pooled_iqm(per_task)
+    # scipy resamples samples of two or more runs only; a task's single run is in every replicate as it is
+    resampled, single = [runs for runs in per_task if len(runs) > 1], [runs for runs in per_task if len(runs) == 1]
+    if not resampled:
+        return value, (value, value)
+
+    def statistic(*samples: np.ndarray, axis: int = -1) -> np.ndarray:
+        fixed = [np.broadcast_to(runs, (*samples[0].shape[:-1], 1)) for runs in single]
+        return trim_mean(np.concatenate([*samples, *fixed], axis=-1), 0.25, axis=-1)
+
+    result = bootstrap(
+        tuple(resampled), statistic, n_resamples=reps, vectorized=True, method="percentile", rng=np.random.default_rng(seed)
+    )
+    low, high = result.confidence_interval
+    return value, (float(low), float(high))
 
 
 def seeds_to_resolve(values_x: np.ndarray, values_y: np.ndarray, alpha: float = 0.05, power: float = 0.8) -> float:

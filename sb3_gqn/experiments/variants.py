@@ -1,7 +1,7 @@
-"""The comparison suite's agents and runs: the agents (:data:`VARIANTS`: the shipped agents; more from a variants file,
-:func:`load_variants`), the suites (:data:`SHORT_SUITE`, :data:`FULL_SUITE`), one run (:class:`RunSpec`) and what each
-run trains and is evaluated on (its rl-zoo3 algorithm, the overrides on its shipped entry, its penalized evaluation
-env).
+"""The comparison suite's agents and runs: the agents (:data:`VARIANTS`: the shipped agents; more from variants files,
+:func:`load_variants` and :func:`with_variants_files`, passed explicitly to what needs them), the suites
+(:data:`SHORT_SUITE`, :data:`FULL_SUITE`), one run (:class:`RunSpec`) and what each run trains and is evaluated on (its
+rl-zoo3 algorithm, the overrides on its shipped entry, its penalized evaluation env).
 
 A variants file (YAML) names further agents, each as the rl-zoo3 algorithm it trains and the hyperparameters it sets
 over that algorithm's shipped entry::
@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import inspect
 import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import gymnasium as gym
@@ -48,24 +50,31 @@ class Variant:
         return overrides
 
 
-#: The shipped agents, by runner name
-VARIANTS: dict[str, Variant] = {
-    "gqn-adaptive": Variant("gqn", {"growth": "adaptive"}),
-    "gqn-linear": Variant("gqn", {"growth": "linear"}),
-    "decqn-2": Variant("decqn", {"bins": 2}),
-    "decqn-9": Variant("decqn", {"bins": 9}),
-    "sac": Variant("sac"),
-    "td3": Variant("td3"),
-    # SBX's SAC (JAX, the sbx extra): SAC with the same entries, run faster
-    "sbx-sac": Variant("sbx_sac"),
-}
+#: The shipped agents, by runner name (read-only: agents of a variants file go into a mapping of their own,
+#: :func:`with_variants_files`)
+VARIANTS: Mapping[str, Variant] = MappingProxyType(
+    {
+        "gqn-adaptive": Variant("gqn", {"growth": "adaptive"}),
+        "gqn-linear": Variant("gqn", {"growth": "linear"}),
+        "decqn-2": Variant("decqn", {"bins": 2}),
+        "decqn-9": Variant("decqn", {"bins": 9}),
+        "sac": Variant("sac"),
+        "td3": Variant("td3"),
+        # SBX's SAC (JAX, the sbx extra): SAC with the same entries, run faster
+        "sbx-sac": Variant("sbx_sac"),
+    }
+)
 ZOO_ALGOS = ("gqn", "decqn", "sac", "td3", "sbx_sac")
 
 
-def load_variants(path: str | Path) -> dict[str, Variant]:
-    """Read a variants file (format in the module's docstring) and add its agents to :data:`VARIANTS`.
+def load_variants(path: str | Path, known: Mapping[str, Variant] = VARIANTS) -> dict[str, Variant]:
+    """Read a variants file (format in the module's docstring): its agents, by name. Nothing global changes: pass
+    them (with the shipped ones, :func:`with_variants_files`) to what runs or reads them.
 
-    :raises ValueError: for an entry without a known ``algo``, with unknown keys, or redefining a shipped agent
+    :param path: the variants file
+    :param known: the agents it may not redefine (default: the shipped ones)
+    :return: the file's agents
+    :raises ValueError: for an entry without a known ``algo``, with unknown keys, or redefining an agent of ``known``
     """
     loaded = {}
     for name, entry in read_entries(path).items():
@@ -82,17 +91,28 @@ def load_variants(path: str | Path) -> dict[str, Variant]:
             {env: dict(values or {}) for env, values in (entry.get("env_hyperparams") or {}).items()},
             list(entry.get("add_env_wrappers") or []),
         )
-        if name in VARIANTS and VARIANTS[name] != variant:
+        if name in known and known[name] != variant:
             raise ValueError(f"{path}: variant {name!r} redefines an agent the runner already has")
         loaded[name] = variant
-    VARIANTS.update(loaded)
     return loaded
 
 
-def warm_started(algo: str) -> bool:
-    """Whether runner agent ``algo`` opens bins with a warm start (``growth_init="interpolate"``, the class default
-    and every shipped entry's). Names the runner does not know (tables written elsewhere) count as warm-started."""
-    variant = VARIANTS.get(algo)
+def with_variants_files(paths: Iterable[str | Path] = ()) -> dict[str, Variant]:
+    """The shipped agents (:data:`VARIANTS`) and those of the variants files ``paths``, by name, in that order.
+
+    :raises ValueError: as :func:`load_variants`, also for a file redefining an earlier file's agent
+    """
+    variants = dict(VARIANTS)
+    for path in paths:
+        variants.update(load_variants(path, variants))
+    return variants
+
+
+def warm_started(algo: str, variants: Mapping[str, Variant] = VARIANTS) -> bool:
+    """Whether agent ``algo`` of ``variants`` opens bins with a warm start (``growth_init="interpolate"``, the class
+    default and every shipped entry's). Names ``variants`` does not hold (tables written elsewhere) count as
+    warm-started."""
+    variant = variants.get(algo)
     return variant is None or variant.hyperparams.get("growth_init", "interpolate") == "interpolate"
 
 
@@ -125,8 +145,21 @@ class RunSpec:
     penalty: float
     seed: int
     steps: int
-    #: what the agent ``algo`` trains (default: :data:`VARIANTS`' entry); carried with the run to worker processes
+    #: what the agent ``algo`` trains (default: the shipped agent of that name, :data:`VARIANTS`; :meth:`of` takes it
+    #: from other agents); carried with the run to worker processes
     variant: Variant | None = field(default=None, compare=False)
+
+    @classmethod
+    def of(
+        cls, algo: str, env: str, penalty: float, seed: int, steps: int, variants: Mapping[str, Variant] = VARIANTS
+    ) -> RunSpec:
+        """The run of agent ``algo`` of ``variants`` (e.g. :func:`with_variants_files`' agents).
+
+        :raises ValueError: for an agent ``variants`` does not hold
+        """
+        if algo not in variants:
+            raise ValueError(f"Unknown agent {algo!r}: {', '.join(variants)} (more through a variants file)")
+        return cls(algo, env, penalty, seed, steps, variants[algo])
 
     def __post_init__(self) -> None:
         if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
@@ -137,7 +170,9 @@ class RunSpec:
             raise ValueError(f"penalty must be a finite number >= 0, got {self.penalty!r}")
         if self.variant is None:
             if self.algo not in VARIANTS:
-                raise ValueError(f"Unknown agent {self.algo!r}: {', '.join(VARIANTS)} (more through a variants file)")
+                raise ValueError(
+                    f"Unknown agent {self.algo!r}: {', '.join(VARIANTS)} (an agent of a variants file: RunSpec.of)"
+                )
             object.__setattr__(self, "variant", VARIANTS[self.algo])
 
     @property
