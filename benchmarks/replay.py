@@ -107,7 +107,7 @@ class HumanoidSizedEnv(gym.Env):
 
 def gradient_step_ms(buffer: ReplayBuffer, prioritized: bool, updates: int) -> float:
     """Milliseconds per GQN gradient step (DecQN defaults: 512x512, batch 256) sampling from ``buffer``."""
-    model = GQN("MlpPolicy", HumanoidSizedEnv(), prioritized_replay=prioritized, buffer_size=1, seed=0)
+    model = GQN("MlpPolicy", HumanoidSizedEnv(), replay_buffer_kwargs=dict(prioritized=prioritized), buffer_size=1, seed=0)
     model.replay_buffer = buffer
     model.set_logger(configure(None, [""]))
     model.train(gradient_steps=10, batch_size=BATCH)

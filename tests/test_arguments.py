@@ -34,18 +34,28 @@ BAD_ARGUMENTS = [
     ("exploration_initial_eps", -0.1, "[0, 1]"),
     ("exploration_final_eps", 2.0, "[0, 1]"),
     ("max_grad_norm", 0.0, "(0, inf)"),
-    ("priority_exponent", -0.5, "[0, inf)"),
-    ("importance_sampling_exponent", 1.5, "[0, 1]"),
-    ("growth_eval_freq", 0, ">= 1"),
-    ("growth_eval_episodes", 0, ">= 1"),
-    ("growth_window", 0, ">= 1"),
-    ("growth_patience", 0, ">= 1"),
-    ("growth_min_improvement", -0.05, "[0, inf)"),
-    ("growth_returns", "greedy", "('evaluation', 'training')"),
     ("growth", "exponential", "('adaptive', 'linear', None)"),
-    ("growth_init", "zeros", "('interpolate', 'none')"),
     ("exploration", "per_joint", "('shared', 'per_dimension')"),
+    ("precision", "fp16", "('auto', 'fp32', 'bf16')"),
+    ("decoding", "median", "('argmax', 'expectation', 'relative')"),
     ("stats_window_size", 0, ">= 1"),
+]
+BAD_SETTINGS = [
+    # (group, key, bad value, the valid range the message states, the 0.2 keyword)
+    ("replay_buffer_kwargs", "alpha", -0.5, "[0, inf)", "priority_exponent"),
+    ("replay_buffer_kwargs", "beta", 1.5, "[0, 1]", "importance_sampling_exponent"),
+    ("replay_buffer_kwargs", "beta_annealing", "yes", "True or False", "importance_sampling_annealing"),
+    ("replay_buffer_kwargs", "prioritized", 1, "True or False", "prioritized_replay"),
+    ("replay_buffer_kwargs", "epsilon", 0.0, "(0, inf)", None),
+    ("growth_kwargs", "eval_freq", 0, ">= 1", "growth_eval_freq"),
+    ("growth_kwargs", "eval_episodes", 0, ">= 1", "growth_eval_episodes"),
+    ("growth_kwargs", "window", 0, ">= 1", "growth_window"),
+    ("growth_kwargs", "patience", 0, ">= 1", "growth_patience"),
+    ("growth_kwargs", "min_improvement", -0.05, "[0, inf)", "growth_min_improvement"),
+    ("growth_kwargs", "probation", 0, ">= 1", "growth_probation"),
+    ("growth_kwargs", "returns_source", "greedy", "('evaluation', 'training')", "growth_returns"),
+    ("growth_kwargs", "init", "zeros", "('interpolate', 'none')", "growth_init"),
+    ("decoding_kwargs", "temperature", 0.0, "float32's positive normal range", "decoding_temperature"),
 ]
 
 
@@ -55,6 +65,18 @@ def test_a_bad_argument_fails_when_the_model_is_built(argument, value, valid_ran
         GQN("MlpPolicy", "Pendulum-v1", **{argument: value}, _init_setup_model=False)
     message = str(error.value)
     assert message.startswith(argument) and valid_range in message and repr(value) in message
+
+
+@pytest.mark.parametrize(("group", "key", "value", "valid_range", "old_keyword"), BAD_SETTINGS)
+def test_a_bad_grouped_setting_fails_when_the_model_is_built_naming_its_key(group, key, value, valid_range, old_keyword):
+    with pytest.raises(ValueError) as error:
+        GQN("MlpPolicy", "Pendulum-v1", **{group: {key: value}}, _init_setup_model=False)
+    message = str(error.value)
+    assert message.startswith(f"{group}[{key!r}]") and valid_range in message and repr(value) in message
+    if old_keyword is not None:  # the 0.2 spelling of the same value fails the same way, after its warning
+        with pytest.warns(DeprecationWarning, match=old_keyword), pytest.raises(ValueError) as old_error:
+            GQN("MlpPolicy", "Pendulum-v1", **{old_keyword: value}, _init_setup_model=False)
+        assert str(old_error.value) == message
 
 
 def test_decqn_checks_its_arguments_too():
@@ -78,14 +100,18 @@ def test_the_buffer_must_hold_a_batch_and_an_n_step_window(arguments, message):
     "arguments",
     [
         dict(gamma=1.0, tau=1.0, exploration_initial_eps=0.0, exploration_final_eps=1.0, exploration_fraction=0.0),
-        dict(gradient_steps=-1, train_freq=(2, "episode"), learning_starts=0, max_grad_norm=None, growth_patience=None),
-        dict(learning_rate=lambda progress: 1e-4 * progress, priority_exponent=0.0, importance_sampling_exponent=1.0),
-        dict(buffer_size=256, batch_size=256, n_steps=1, growth_min_improvement=0.0, growth_window=1),
-        dict(batch_size=np.int64(64), learning_rate=np.float32(3e-4), growth_returns="training"),
+        dict(gradient_steps=-1, train_freq=(2, "episode"), learning_starts=0, max_grad_norm=None),
+        dict(growth_kwargs=dict(patience=None, probation=None)),
+        dict(learning_rate=lambda progress: 1e-4 * progress, replay_buffer_kwargs=dict(alpha=0.0, beta=1.0)),
+        dict(buffer_size=256, batch_size=256, n_steps=1, growth_kwargs=dict(min_improvement=0.0, window=1)),
+        dict(batch_size=np.int64(64), learning_rate=np.float32(3e-4), growth_kwargs=dict(returns_source="training")),
+        dict(decoding_kwargs=dict(temperature=None), replay_buffer_kwargs=dict(beta_annealing=True, epsilon=1e-3)),
     ],
 )
 def test_the_edges_of_each_range_are_accepted(arguments):
-    GQN("MlpPolicy", "Pendulum-v1", **arguments)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)  # the new spelling warns of nothing
+        GQN("MlpPolicy", "Pendulum-v1", **arguments)
 
 
 @pytest.mark.parametrize(

@@ -51,9 +51,10 @@ def weights(model: GQN) -> list[th.Tensor]:
 
 
 @pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
-@pytest.mark.parametrize("prioritized_replay", [True, False])
-def test_a_non_finite_observation_stops_learn_before_it_is_stored_or_trained_on(value, prioritized_replay):
-    model = GQN("MlpPolicy", BadObservationEnv(bad_step=32, value=value), prioritized_replay=prioritized_replay, **TINY)
+@pytest.mark.parametrize("prioritized", [True, False])
+def test_a_non_finite_observation_stops_learn_before_it_is_stored_or_trained_on(value, prioritized):
+    env = BadObservationEnv(bad_step=32, value=value)
+    model = GQN("MlpPolicy", env, replay_buffer_kwargs=dict(prioritized=prioritized), **TINY)
     with pytest.raises(ValueError, match=r"Non-finite observation from the env's step 32 \(env 0, index \(1,\): "):
         model.learn(100)
     # the 31 good transitions are stored, the bad one is not, and every weight is finite
@@ -121,14 +122,14 @@ def test_loading_another_algorithms_file_names_it(tmp_path):
 
 @pytest.mark.parametrize("saved_prioritized", [True, False])
 def test_loading_the_other_kind_of_replay_buffer_is_an_error_and_keeps_the_buffer(tmp_path, saved_prioritized):
-    saved = GQN("MlpPolicy", DecliningEnv(), prioritized_replay=saved_prioritized, **TINY).learn(30)
+    saved = GQN("MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(prioritized=saved_prioritized), **TINY).learn(30)
     saved.save_replay_buffer(tmp_path / "buffer")
-    model = GQN("MlpPolicy", DecliningEnv(), prioritized_replay=not saved_prioritized, **TINY)
+    model = GQN("MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(prioritized=not saved_prioritized), **TINY)
     kept = model.replay_buffer
     have = "prioritized" if saved_prioritized else "uniform"
     with pytest.raises(
         ValueError,
-        match=f"holds a {have} replay buffer .* load it into a model made with prioritized_replay={saved_prioritized}",
+        match=rf"holds a {have} replay buffer .* made with replay_buffer_kwargs=dict\(prioritized={saved_prioritized}\)",
     ):
         model.load_replay_buffer(tmp_path / "buffer")
     assert model.replay_buffer is kept
@@ -148,7 +149,7 @@ def test_linear_growth_keeps_one_step_counter_when_learn_resets_num_timesteps(tm
 
 
 def test_adaptive_growth_keeps_one_step_counter_when_learn_resets_num_timesteps(tmp_path):
-    kwargs = dict(growth="adaptive", growth_eval_freq=20, growth_window=2, growth_patience=1, train_freq=1)
+    kwargs = dict(growth="adaptive", growth_kwargs=dict(eval_freq=20, window=2, patience=1), train_freq=1)
     model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), **kwargs, **TINY)
     model.learn(100)
     model.save(tmp_path / "model")
@@ -230,25 +231,26 @@ def test_another_algorithms_replay_buffer_is_refused_and_the_model_keeps_its_own
     sac = SAC("MlpPolicy", "Pendulum-v1", buffer_size=100, learning_starts=10)
     sac.learn(20)
     sac.save_replay_buffer(tmp_path / "sac_buffer")
-    for prioritized_replay in (False, True):
-        model = GQN("MlpPolicy", "Pendulum-v1", prioritized_replay=prioritized_replay, **TINY)
+    for prioritized in (False, True):
+        model = GQN("MlpPolicy", "Pendulum-v1", replay_buffer_kwargs=dict(prioritized=prioritized), **TINY)
         kept = model.replay_buffer
         with pytest.raises(ValueError, match=r"sac_buffer(\.pkl)? holds a (uniform )?replay buffer"):
             model.load_replay_buffer(tmp_path / "sac_buffer")
         assert model.replay_buffer is kept
-    model = GQN("MlpPolicy", "Pendulum-v1", prioritized_replay=False, **TINY)
+    model = GQN("MlpPolicy", "Pendulum-v1", replay_buffer_kwargs=dict(prioritized=False), **TINY)
     with pytest.raises(ValueError, match=r"actions in Box\(-2\.0, 2\.0, \(1,\), float32\) \(ReplayBuffer\), but this model "):
         model.load_replay_buffer(tmp_path / "sac_buffer")
 
 
 def test_a_buffer_of_other_bins_or_another_n_step_return_is_refused(tmp_path):
-    GQN("MlpPolicy", DecliningEnv(), bins=(2, 5), prioritized_replay=False, **TINY).learn(20).save_replay_buffer(
+    uniform = dict(prioritized=False)
+    GQN("MlpPolicy", DecliningEnv(), bins=(2, 5), replay_buffer_kwargs=uniform, **TINY).learn(20).save_replay_buffer(
         tmp_path / "five"
     )
-    model = GQN("MlpPolicy", DecliningEnv(), prioritized_replay=False, **TINY)
+    model = GQN("MlpPolicy", DecliningEnv(), replay_buffer_kwargs=uniform, **TINY)
     with pytest.raises(ValueError, match=r"actions in MultiDiscrete\(\[5 5\]\) .* bin indices in MultiDiscrete\(\[9 9\]\)"):
         model.load_replay_buffer(tmp_path / "five")
-    GQN("MlpPolicy", DecliningEnv(), n_steps=1, prioritized_replay=False, **TINY).learn(20).save_replay_buffer(
+    GQN("MlpPolicy", DecliningEnv(), n_steps=1, replay_buffer_kwargs=uniform, **TINY).learn(20).save_replay_buffer(
         tmp_path / "one_step"
     )
     with pytest.raises(ValueError, match=r"holds a 1-step replay buffer \(ReplayBuffer\), but this model learns from 3-step"):

@@ -216,10 +216,16 @@ def test_gqn_uses_prioritized_replay_by_default():
     assert not np.allclose(stored, stored[0])  # the TD errors were written back
     assert model.logger.name_to_value.get("replay/importance_sampling_exponent", 0.2) == pytest.approx(0.2)
 
-    uniform = GQN("MlpPolicy", DecliningEnv(), prioritized_replay=False, bins=3, growth=None)
-    assert type(uniform.replay_buffer) is NStepReplayBuffer
-    with pytest.raises(ValueError, match="not prioritized"):
-        GQN("MlpPolicy", DecliningEnv(), replay_buffer_class=NStepReplayBuffer, bins=3, growth=None)
+    uniform = GQN("MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(prioritized=False), bins=3, growth=None)
+    assert type(uniform.replay_buffer) is NStepReplayBuffer and not uniform.prioritized_replay
+    # a class given is the class used (SB3's rule), with GQN's n-step return
+    given = GQN("MlpPolicy", DecliningEnv(), replay_buffer_class=NStepReplayBuffer, n_steps=2, bins=3, growth=None)
+    assert type(given.replay_buffer) is NStepReplayBuffer and (given.replay_buffer.n_steps, given.replay_buffer.gamma) == (
+        2,
+        0.99,
+    )
+    with pytest.raises(ValueError, match=r"prioritized'\]=True contradicts replay_buffer_class=NStepReplayBuffer"):
+        GQN("MlpPolicy", DecliningEnv(), replay_buffer_class=NStepReplayBuffer, replay_buffer_kwargs=dict(prioritized=True))
 
 
 def test_importance_sampling_annealing_reaches_one():
@@ -231,8 +237,9 @@ def test_importance_sampling_annealing_reaches_one():
         train_freq=1,
         bins=3,
         growth=None,
-        importance_sampling_annealing=True,
+        replay_buffer_kwargs=dict(beta_annealing=True),
     )
+    assert (model.replay_buffer.initial_beta, model.replay_buffer.beta_annealing) == (0.2, True)
     model.learn(400)
     # beta = 0.2 + 0.8 * (progress made) at the last update, one step before the end
     assert model.replay_buffer.beta == pytest.approx(1.0, abs=0.8 / 400 + 1e-6)

@@ -23,7 +23,7 @@ def test_unknown_command_and_version(capsys):
     assert main(["trian"]) == 2
     assert "unknown command 'trian'" in capsys.readouterr().err
     assert main(["--version"]) == 0
-    assert capsys.readouterr().out.strip() == f"sb3-gqn {__version__}" == "sb3-gqn 0.2.0"
+    assert capsys.readouterr().out.strip() == f"sb3-gqn {__version__}" == "sb3-gqn 0.3.0"
 
 
 @pytest.mark.parametrize("command", ["benchmark", "report", "reference-run"])

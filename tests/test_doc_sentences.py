@@ -146,9 +146,16 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         ),
         "bins=(3, 9) needs 9 choices per action dimension, but the env's action space Discrete(2) has 2: pass bins=2 "
         "(or a pair ending in it)": lambda: GQN("MlpPolicy", "CartPole-v1", bins=(3, 9)),
-        "decoding_temperature must be a number in [1.175e-38, 3.403e+38], float32's positive normal range (the "
-        "utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN)": lambda: GQN(
-            "MlpPolicy", DecliningEnv(), decoding_temperature=1e300
+        "decoding_kwargs['temperature'] must be None or a number in [1.175e-38, 3.403e+38], float32's positive normal "
+        "range (the utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN)": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), decoding_kwargs=dict(temperature=1e300)
+        ),
+        "growth_kwargs has no setting 'patiense': its keys are ('init', 'eval_freq', 'eval_episodes', 'window', "
+        "'returns_source', 'patience', 'min_improvement', 'probation')": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), growth_kwargs=dict(patiense=3)
+        ),
+        "replay_buffer_kwargs['alpha'] must be a finite number in [0, inf), got -1": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(alpha=-1)
         ),
         "policy_kwargs['net_arch'] must be a list of layer sizes, integers >= 1, got [0]": lambda: GQN(
             "MlpPolicy", DecliningEnv(), policy_kwargs=dict(net_arch=[0])

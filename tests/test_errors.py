@@ -83,8 +83,8 @@ def test_unknown_growth(growth):
 
 
 def test_unknown_growth_returns():
-    with pytest.raises(ValueError, match="growth_returns"):
-        GQN("MlpPolicy", DecliningEnv(), growth_returns="episodes")
+    with pytest.raises(ValueError, match=r"growth_kwargs\['returns_source'\]"):
+        GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(returns_source="episodes"))
 
 
 def test_discrete_env_with_other_bin_count():

@@ -36,7 +36,7 @@ def test_the_expectation_weighs_the_active_bins_by_their_softmax():
 
 
 def test_predict_returns_the_expectation_and_explores_over_bins_as_before():
-    model = pendulum_model(decoding="expectation", decoding_temperature=0.5)
+    model = pendulum_model(decoding="expectation", decoding_kwargs=dict(temperature=0.5))
     batch = observations(model.observation_space, count=64)
     actions, _ = model.predict(batch, deterministic=True)
     utilities = model.policy.greedy_utilities(model.policy.obs_to_tensor(batch)[0]).detach().numpy()[:, 0, :]
@@ -55,7 +55,7 @@ def test_predict_returns_the_expectation_and_explores_over_bins_as_before():
 
 @pytest.mark.parametrize("runtime", ["torchscript", "onnx"])
 def test_the_exports_act_as_predict_does(runtime, tmp_path):
-    model = pendulum_model(decoding="expectation", decoding_temperature=0.3)
+    model = pendulum_model(decoding="expectation", decoding_kwargs=dict(temperature=0.3))
     batch = observations(model.observation_space)
     expected, _ = model.predict(batch, deterministic=True)
     if runtime == "torchscript":
@@ -68,30 +68,36 @@ def test_the_exports_act_as_predict_does(runtime, tmp_path):
 
 
 def test_learn_save_and_load_keep_the_decoding(tmp_path):
-    model = GQN("MlpPolicy", "Pendulum-v1", decoding="expectation", decoding_temperature=0.2, learning_starts=50,
+    model = GQN("MlpPolicy", "Pendulum-v1", decoding="expectation", decoding_kwargs=dict(temperature=0.2), learning_starts=50,
                 policy_kwargs=dict(net_arch=[16]), seed=0).learn(120)  # fmt: skip
     model.save(tmp_path / "model")
     loaded = GQN.load(tmp_path / "model")
-    assert (loaded.decoding, loaded.decoding_temperature) == ("expectation", 0.2)
+    assert (loaded.decoding, loaded.decoding_kwargs) == ("expectation", {"temperature": 0.2})
     batch = observations(model.observation_space, count=8)
     np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], model.predict(batch, deterministic=True)[0])
 
 
-RANGE = r"decoding_temperature must be None or a number in \[1\.175e-38, 3\.403e\+38\], float32's positive normal range"
+RANGE = (
+    r"decoding_kwargs\['temperature'\] must be None or a number in \[1\.175e-38, 3\.403e\+38\], float32's positive normal "
+    "range"
+)
 
 
 @pytest.mark.parametrize(
     "kwargs, message",
     [
         (dict(decoding="median"), r"decoding must be one of \('argmax', 'expectation', 'relative'\), got 'median'"),
-        (dict(decoding="expectation", decoding_temperature=0.0), RANGE + r".*got 0\.0"),
-        (dict(decoding_temperature=float("nan")), RANGE + ".*got nan"),
-        (dict(decoding_temperature=True), RANGE + ".*got True"),
+        (dict(decoding="expectation", decoding_kwargs=dict(temperature=0.0)), RANGE + r".*got 0\.0"),
+        (dict(decoding_kwargs=dict(temperature=float("nan"))), RANGE + ".*got nan"),
+        (dict(decoding_kwargs=dict(temperature=True)), RANGE + ".*got True"),
         # float32 has no such temperature: 1e-300 is 0 there and 1e300 inf, and the softmax of either was NaN
-        (dict(decoding="expectation", decoding_temperature=1e-300), RANGE + r".*got 1e-300"),
-        (dict(decoding="expectation", decoding_temperature=1e300), RANGE + r".*got 1e\+300"),
-        (dict(decoding="expectation", decoding_temperature=1e-39), RANGE + r".*got 1e-39"),  # subnormal in float32
-        (dict(decoding="expectation", decoding_temperature="0.3"), RANGE + r".*got '0\.3'"),
+        (dict(decoding="expectation", decoding_kwargs=dict(temperature=1e-300)), RANGE + r".*got 1e-300"),
+        (dict(decoding="expectation", decoding_kwargs=dict(temperature=1e300)), RANGE + r".*got 1e\+300"),
+        (
+            dict(decoding="expectation", decoding_kwargs=dict(temperature=1e-39)),
+            RANGE + r".*got 1e-39",
+        ),  # subnormal in float32
+        (dict(decoding="expectation", decoding_kwargs=dict(temperature="0.3")), RANGE + r".*got '0\.3'"),
     ],
 )
 def test_bad_decoding_arguments_are_refused(kwargs, message, tmp_path):
@@ -108,7 +114,7 @@ def test_a_trained_argmax_model_switches_to_the_expectation_at_load(tmp_path):
     deterministic action is then the softmax-weighted bin value (tested against masked_expectation)."""
     model = pendulum_model()
     model.save(tmp_path / "model")
-    loaded = GQN.load(tmp_path / "model", decoding="expectation", decoding_temperature=0.5)
+    loaded = GQN.load(tmp_path / "model", decoding="expectation", decoding_kwargs=dict(temperature=0.5))
     batch = observations(model.observation_space, count=8)
     utilities = model.policy.greedy_utilities(model.policy.obs_to_tensor(batch)[0]).detach()
     bin_values = th.as_tensor(model.action_grid.values, dtype=utilities.dtype)
@@ -140,12 +146,12 @@ def test_a_temperature_float32_cannot_hold_is_refused_and_the_range_ends_act_fin
     range is refused (constructor and load), and its nearest end of the range acts: the greedy bin's value at the low
     end, the mean of the active bins' values at the high end."""
     with pytest.raises(ValueError, match=RANGE):
-        pendulum_model(decoding="expectation", decoding_temperature=temperature)
+        pendulum_model(decoding="expectation", decoding_kwargs=dict(temperature=temperature))
     pendulum_model().save(tmp_path / "model")
     with pytest.raises(ValueError, match=RANGE):
-        GQN.load(tmp_path / "model", decoding="expectation", decoding_temperature=temperature)
+        GQN.load(tmp_path / "model", decoding="expectation", decoding_kwargs=dict(temperature=temperature))
     end = TEMPERATURE_RANGE[0] if temperature < 1 else TEMPERATURE_RANGE[1]
-    model = pendulum_model(decoding="expectation", decoding_temperature=end)
+    model = pendulum_model(decoding="expectation", decoding_kwargs=dict(temperature=end))
     batch = observations(model.observation_space, count=64)
     if temperature < 1:  # the greedy bin's torque
         expected = pendulum_model().predict(batch, deterministic=True)[0]

@@ -85,7 +85,9 @@ def models() -> dict[str, tuple[GQN, spaces.Space]]:
             MLP_SPACE,
         ),
         "dict": (
-            grown_model(ObservationEnv(DICT_SPACE), "MultiInputPolicy", n_steps=1, prioritized_replay=False),
+            grown_model(
+                ObservationEnv(DICT_SPACE), "MultiInputPolicy", n_steps=1, replay_buffer_kwargs=dict(prioritized=False)
+            ),
             DICT_SPACE,
         ),
         "image": (

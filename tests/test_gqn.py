@@ -82,9 +82,7 @@ def test_adaptive_growth_happens_when_returns_stagnate(returns_source):
         "MlpPolicy",
         DecliningEnv(length=5),
         growth="adaptive",
-        growth_eval_freq=10,
-        growth_window=2,
-        growth_returns=returns_source,
+        growth_kwargs=dict(eval_freq=10, window=2, returns_source=returns_source),
         verbose=1,
         **SMALL,
     )
@@ -101,9 +99,7 @@ def test_adaptive_evaluation_episodes_are_greedy():
         DecliningEnv(length=5, action_dims=4),
         bins=(2, 9),
         growth="adaptive",
-        growth_eval_freq=50,
-        growth_window=1000,  # never decides: we only look at the actions
-        growth_patience=None,
+        growth_kwargs=dict(eval_freq=50, window=1000, patience=None),  # never decides: we only look at the actions
         exploration_initial_eps=1.0,
         exploration_final_eps=1.0,
         train_freq=8,  # rollouts of 8 steps: learn(500) ends at step 504
@@ -136,9 +132,7 @@ def test_save_load_round_trip(tmp_path):
         DecliningEnv(),
         bins=(2, 9),
         growth="adaptive",
-        growth_eval_freq=10,
-        growth_window=100,
-        growth_patience=None,
+        growth_kwargs=dict(eval_freq=10, window=100, patience=None),
         **SMALL,
     )
     model.learn(150)
@@ -194,13 +188,16 @@ def test_multiple_envs():
 
 def test_adaptive_growth_with_multiple_envs():
     env = make_vec_env(DecliningEnv, n_envs=2)
-    model = GQN("MlpPolicy", env, growth="adaptive", growth_eval_freq=10, growth_window=2, growth_eval_episodes=2, **SMALL)
+    model = GQN("MlpPolicy", env, growth="adaptive", growth_kwargs=dict(eval_freq=10, window=2, eval_episodes=2), **SMALL)
     model.learn(600)
     assert model.active_bins == 9
 
 
 def test_dict_observations_with_multi_input_policy():
-    model = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, prioritized_replay=False, growth="linear", **SMALL)
+    uniform = dict(prioritized=False)
+    model = GQN(
+        "MultiInputPolicy", DecliningEnv(dict_obs=True), n_steps=1, replay_buffer_kwargs=uniform, growth="linear", **SMALL
+    )
     model.learn(300)
     assert model.active_bins == 9
     action, _ = model.predict({"state": np.zeros(3, np.float32), "time": np.zeros(1, np.float32)}, deterministic=True)
@@ -217,10 +214,12 @@ def test_dict_observations_get_n_step_and_prioritized_replay_by_default():
     assert type(model.replay_buffer) is PrioritizedDictReplayBuffer and model.replay_buffer.n_steps == 3
     model.learn(300)
     assert model._n_updates > 0 and model.replay_buffer.max_priority != 1.0  # priorities were updated
-    uniform = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), prioritized_replay=False, **SMALL)
+    uniform = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), replay_buffer_kwargs=dict(prioritized=False), **SMALL)
     assert type(uniform.replay_buffer) is NStepDictReplayBuffer and uniform.replay_buffer.n_steps == 3
     uniform.learn(300)
-    one_step = GQN("MultiInputPolicy", DecliningEnv(dict_obs=True), prioritized_replay=False, n_steps=1, **SMALL)
+    one_step = GQN(
+        "MultiInputPolicy", DecliningEnv(dict_obs=True), replay_buffer_kwargs=dict(prioritized=False), n_steps=1, **SMALL
+    )
     assert type(one_step.replay_buffer) is DictReplayBuffer
 
 
@@ -313,7 +312,9 @@ def test_interpolate_warm_start_keeps_every_greedy_action_when_a_level_opens():
     observations = np.random.default_rng(1).normal(size=(500, 3)).astype(np.float32)
     changed = {}
     for growth_init in ("interpolate", "none"):
-        model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth=None, growth_init=growth_init, bins=(2, 9), **SMALL)
+        model = GQN(
+            "MlpPolicy", DecliningEnv(action_dims=3), growth=None, growth_kwargs=dict(init=growth_init), bins=(2, 9), **SMALL
+        )
         _randomize_head(model)
         changed[growth_init] = 0
         for _ in range(3):
@@ -336,7 +337,7 @@ def test_a_jump_over_several_levels_interpolates_level_by_level():
 
 
 def test_growth_init_none_leaves_the_new_bins_as_they_are():
-    model = GQN("MlpPolicy", DecliningEnv(), growth=None, growth_init="none", bins=(2, 9), **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), growth=None, growth_kwargs=dict(init="none"), bins=(2, 9), **SMALL)
     _randomize_head(model)
     weights = model.q_net.head.weight.detach().clone()
     model.grow()
@@ -369,15 +370,16 @@ def test_growth_none_with_a_bins_pair_trains_at_the_first_level():
 @pytest.mark.parametrize(
     "options",
     [
-        dict(growth="adaptive", growth_init="interpolate", exploration="shared", growth_patience=2),
-        dict(growth="adaptive", growth_init="none", exploration="per_dimension", growth_patience=None),
-        dict(growth="adaptive", growth_returns="training", growth_patience=1, growth_min_improvement=0.0),
-        dict(growth="linear", growth_init="none", exploration="per_dimension"),
+        dict(growth="adaptive", growth_kwargs=dict(init="interpolate", patience=2), exploration="shared"),
+        dict(growth="adaptive", growth_kwargs=dict(init="none", patience=None), exploration="per_dimension"),
+        dict(growth="adaptive", growth_kwargs=dict(returns_source="training", patience=1, min_improvement=0.0)),
+        dict(growth="linear", growth_kwargs=dict(init="none"), exploration="per_dimension"),
         dict(growth=None, exploration="shared"),
     ],
 )
 def test_every_growth_and_exploration_option_learns(options):
-    model = GQN("MlpPolicy", DecliningEnv(), growth_eval_freq=10, **options, **SMALL)
+    options = {**options, "growth_kwargs": {"eval_freq": 10, **options.get("growth_kwargs", {})}}
+    model = GQN("MlpPolicy", DecliningEnv(), **options, **SMALL)
     model.learn(400)
     assert model.num_timesteps == 400 and model._n_updates > 0
     assert model.exploration == options.get("exploration", "shared")
@@ -386,9 +388,9 @@ def test_every_growth_and_exploration_option_learns(options):
 def test_plateau_rule_grows_on_a_flat_return_where_eq4_alone_does_not():
     from tests.envs import FlatEnv
 
-    eq4_only = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_eval_freq=10, growth_patience=None, **SMALL).learn(400)
+    eq4_only = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_kwargs=dict(eval_freq=10, patience=None), **SMALL).learn(400)
     assert eq4_only.active_bins == 2
-    with_plateau = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_eval_freq=10, growth_patience=2, **SMALL).learn(400)
+    with_plateau = GQN("MlpPolicy", FlatEnv(), bins=(2, 9), growth_kwargs=dict(eval_freq=10, patience=2), **SMALL).learn(400)
     assert with_plateau.active_bins == 9
 
 

@@ -67,13 +67,13 @@ def test_adaptive_evaluation_episodes_are_scheduled_and_averaged():
 
 
 def test_adaptive_rejects_bad_arguments():
-    with pytest.raises(ValueError, match="growth_returns"):
+    with pytest.raises(ValueError, match=r"growth_kwargs\['returns_source'\]"):
         AdaptiveGrowth(returns_source="bogus")
-    with pytest.raises(ValueError, match="growth_window must be an integer >= 1, got 0"):
+    with pytest.raises(ValueError, match=r"growth_kwargs\['window'\] must be an integer >= 1, got 0"):
         AdaptiveGrowth(window=0)
-    with pytest.raises(ValueError, match="growth_patience must be an integer >= 1, got True"):
+    with pytest.raises(ValueError, match=r"growth_kwargs\['patience'\] must be an integer >= 1, got True"):
         AdaptiveGrowth(patience=True)
-    with pytest.raises(ValueError, match=r"growth_min_improvement must be a finite number in \[0, inf\), got nan"):
+    with pytest.raises(ValueError, match=r"growth_kwargs\['min_improvement'\] must be a finite number in \[0, inf\), got nan"):
         AdaptiveGrowth(min_improvement=float("nan"))
     assert AdaptiveGrowth(patience=None).patience is None
 

@@ -44,7 +44,7 @@ def test_the_runner_records_both_decodings_on_the_same_episodes(tmp_path):
     own = rollout_figures(model, make_eval_env(spec), 2, seed=10_000)
     with decoded_as(model, "relative"):
         relative = rollout_figures(model, make_eval_env(spec), 2, seed=10_000)
-    assert model.decoding == "argmax" and model.decoding_temperature is None  # restored after the block
+    assert model.decoding == "argmax" and model.decoding_kwargs == {}  # restored after the block
     assert float(final[""]["task_return"]) == pytest.approx(own.task_return)
     assert float(final["relative"]["task_return"]) == pytest.approx(relative.task_return)
     assert float(final["relative"]["smoothness"]) == pytest.approx(relative.smoothness)

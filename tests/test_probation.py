@@ -1,5 +1,6 @@
-"""Probation of opened levels (``growth_probation``): the rule against hand values, the schedule's bookkeeping, the
-masks the model acts, explores and bootstraps with, save/load, and the growth check that reads deployments."""
+"""Probation of opened levels (``growth_kwargs=dict(probation=k)``): the rule against hand values, the schedule's
+bookkeeping, the masks the model acts, explores and bootstraps with, save/load, and the growth check that reads
+deployments."""
 
 import pickle
 
@@ -91,13 +92,13 @@ def test_a_schedule_saved_before_probation_loads_without_it():
 
 
 def test_growth_probation_must_be_a_positive_int():
-    with pytest.raises(ValueError, match="growth_probation"):
-        GQN("MlpPolicy", DecliningEnv(), growth_probation=0, **SMALL)
+    with pytest.raises(ValueError, match=r"growth_kwargs\['probation'\]"):
+        GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(probation=0), **SMALL)
 
 
 def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_level():
     # predict acting on the online network, which this test edits (acting_tau=None)
-    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth_probation=2, acting_tau=None, **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=3), growth_kwargs=dict(probation=2), acting_tau=None, **SMALL)
     model.grow(1, probation=True)  # 2 -> 3 bins opened, the deployed level stays at 2
     assert (model.active_bins, model.deployed_bins) == (3, 2)
     assert model.policy.active_bins_mask.tolist() == active_bin_mask(9, 2).tolist()
@@ -123,7 +124,7 @@ def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_lev
 def test_on_probation_the_td_target_maximizes_over_the_deployed_level(monkeypatch):
     import sb3_gqn.gqn.gqn as gqn_module
 
-    model = GQN("MlpPolicy", DecliningEnv(), growth_probation=2, **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(probation=2), **SMALL)
     model.learn(150)  # fills the buffer, no growth decision yet (window 3 of 2 500-step evaluations)
     masks = []
     original = gqn_module.critic_ensemble_targets
@@ -141,7 +142,7 @@ def test_on_probation_the_td_target_maximizes_over_the_deployed_level(monkeypatc
 
 
 def test_growing_by_hand_deploys_at_once_and_ends_a_probation():
-    model = GQN("MlpPolicy", DecliningEnv(), growth_probation=2, **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(probation=2), **SMALL)
     model.growth_schedule.start_probation(10.0)
     model.grow(1, probation=True)
     model.grow(2)  # by hand
@@ -151,7 +152,7 @@ def test_growing_by_hand_deploys_at_once_and_ends_a_probation():
 
 def test_learn_deploys_each_opened_level_after_its_probation():
     # probation=1: every level opened by the plateau rule is deployed at the next evaluation, whatever it returns
-    model = GQN("MlpPolicy", FlatEnv(), growth_eval_freq=10, growth_patience=2, growth_probation=1, **SMALL)
+    model = GQN("MlpPolicy", FlatEnv(), growth_kwargs=dict(eval_freq=10, patience=2, probation=1), **SMALL)
     model.learn(600)
     assert model.active_bins == 9 and model.deployed_bins == 9
     opened = [step for step, _ in model.growth_events]
@@ -162,18 +163,18 @@ def test_learn_deploys_each_opened_level_after_its_probation():
     assert not model.growth_schedule.on_probation and model.growth_schedule.pending_episodes == 0
 
 
-@pytest.mark.parametrize("growth_probation", [None, 1, 4])
-def test_every_probation_value_learns(growth_probation):
-    model = GQN("MlpPolicy", DecliningEnv(), growth_eval_freq=10, growth_probation=growth_probation, **SMALL)
+@pytest.mark.parametrize("probation", [None, 1, 4])
+def test_every_probation_value_learns(probation):
+    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(eval_freq=10, probation=probation), **SMALL)
     model.learn(400)
     assert model._n_updates > 0 and model.deployed_level <= model.growth_level
-    if growth_probation is None:
+    if probation is None:
         assert model.deployments == model.growth_events
 
 
 def test_a_probation_survives_save_and_load(tmp_path):
     model = GQN(
-        "MlpPolicy", DecliningEnv(), growth_eval_freq=10, growth_window=1000, growth_patience=None, growth_probation=3, **SMALL
+        "MlpPolicy", DecliningEnv(), growth_kwargs=dict(eval_freq=10, window=1000, patience=None, probation=3), **SMALL
     )
     model.learn(150)
     model.growth_schedule.start_probation(-4.0)

@@ -58,7 +58,7 @@ def test_equal_utilities_give_the_mean_of_the_active_bins():
 
 
 def test_predict_acts_on_the_relative_expectation():
-    model = pendulum_model(decoding="relative", decoding_temperature=0.5)
+    model = pendulum_model(decoding="relative", decoding_kwargs=dict(temperature=0.5))
     batch = observations(model.observation_space, count=64)
     actions, _ = model.predict(batch, deterministic=True)
     utilities = model.policy.greedy_utilities(model.policy.obs_to_tensor(batch)[0]).detach().numpy()[:, 0, :]
@@ -87,8 +87,8 @@ def test_the_exports_act_as_predict_does(runtime, tmp_path):
 def test_each_decoding_has_its_own_default_temperature(tmp_path):
     for decoding, temperature in DEFAULT_DECODING_TEMPERATURES.items():
         model = pendulum_model(decoding=decoding)
-        assert model.decoding_temperature is None and model.softmax_temperature == temperature
-    assert pendulum_model(decoding="relative", decoding_temperature=0.7).softmax_temperature == 0.7
+        assert model.decoding_kwargs == {} and model.softmax_temperature == temperature
+    assert pendulum_model(decoding="relative", decoding_kwargs=dict(temperature=0.7)).softmax_temperature == 0.7
     # a model trained with the argmax can act on the relative decoding: load() switches it
     pendulum_model().save(tmp_path / "model")
     loaded = GQN.load(tmp_path / "model", decoding="relative")
@@ -96,11 +96,11 @@ def test_each_decoding_has_its_own_default_temperature(tmp_path):
 
 
 def test_learn_save_and_load_keep_the_relative_decoding(tmp_path):
-    model = GQN("MlpPolicy", "Pendulum-v1", decoding="relative", decoding_temperature=0.2, learning_starts=50,
+    model = GQN("MlpPolicy", "Pendulum-v1", decoding="relative", decoding_kwargs=dict(temperature=0.2), learning_starts=50,
                 policy_kwargs=dict(net_arch=[16]), seed=0).learn(120)  # fmt: skip
     model.save(tmp_path / "model")
     loaded = GQN.load(tmp_path / "model")
-    assert (loaded.decoding, loaded.decoding_temperature) == ("relative", 0.2)
+    assert (loaded.decoding, loaded.decoding_kwargs) == ("relative", {"temperature": 0.2})
     batch = observations(model.observation_space, count=8)
     np.testing.assert_allclose(loaded.predict(batch, deterministic=True)[0], model.predict(batch, deterministic=True)[0])
 

@@ -69,7 +69,7 @@ def test_residual_torso_rejects_uneven_or_blockless_net_arch(net_arch):
     [
         (dict(layer_norm=True), "leave layer_norm and residual False"),
         (dict(residual=True), "leave layer_norm and residual False"),
-        (dict(activation_fn=nn.ELU), "leave activation_fn at its default, got ELU"),
+        (dict(activation_fn=nn.ELU), "leave activation_fn unset, got ELU"),
     ],
 )
 def test_residual_torso_rejects_the_options_it_would_ignore(conflict, message):

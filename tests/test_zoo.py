@@ -98,8 +98,7 @@ def test_converter_reproduces_the_sampler():
         "policy_kwargs": {"net_arch": [256, 256]},
         "bins": (9, 65),
         "growth": "linear",
-        "growth_patience": None,
-        "growth_init": "none",
+        "growth_kwargs": {"patience": None, "init": "none"},
     }
 
 

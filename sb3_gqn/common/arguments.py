@@ -4,6 +4,7 @@ and the valid range, instead of deep inside SB3, NumPy or torch at the first gra
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -99,15 +100,13 @@ _NUMBER_ARGUMENTS = {
     "exploration_fraction": (0.0, 1.0, False),
     "exploration_initial_eps": (0.0, 1.0, False),
     "exploration_final_eps": (0.0, 1.0, False),
-    "priority_exponent": (0.0, math.inf, False),
-    "importance_sampling_exponent": (0.0, 1.0, False),
 }
 #: optional numeric arguments (``None`` switches them off): (low, high, low_open)
 _OPTIONAL_NUMBER_ARGUMENTS = {"acting_tau": (0.0, 1.0, True), "max_grad_norm": (0.0, math.inf, True)}
 
 
 def check_learning_arguments(**arguments: Any) -> dict[str, Any]:
-    """GQN's learning arguments (learning rate, replay, update, exploration and priority settings), each checked as
+    """GQN's learning arguments (learning rate, replay, update and exploration settings), each checked as
     above; returns them normalized (ints as ``int``, numbers as ``float``). ``gradient_steps`` may be 0 (SB3's
     "collect only") or -1 (as many as env steps)."""
     checked = dict(arguments)
@@ -125,14 +124,9 @@ def check_learning_arguments(**arguments: Any) -> dict[str, Any]:
     return checked
 
 
-#: the replay-buffer keywords GQN sets from its own arguments (``n_steps``, ``gamma``, ``priority_exponent``,
-#: ``importance_sampling_exponent``): a different value in ``replay_buffer_kwargs`` would be silently replaced
-_BUFFER_KEYWORDS = {
-    "n_steps": "n_steps",
-    "gamma": "gamma",
-    "alpha": "priority_exponent",
-    "beta": "importance_sampling_exponent",
-}
+#: the replay-buffer keywords GQN sets from its own arguments: a different value in ``replay_buffer_kwargs`` would be
+#: silently replaced
+_BUFFER_KEYWORDS = ("n_steps", "gamma")
 
 
 def check_model_arguments(policy_kwargs: Any, replay_buffer_kwargs: Any, seed: Any, learning: dict[str, Any]) -> None:
@@ -150,11 +144,11 @@ def check_model_arguments(policy_kwargs: Any, replay_buffer_kwargs: Any, seed: A
         isinstance(net_arch, (list, tuple)) and all(_is_int(size) and size >= 1 for size in net_arch)
     ):
         raise ValueError(f"policy_kwargs['net_arch'] must be a list of layer sizes, integers >= 1, got {net_arch!r}")
-    for key, argument in _BUFFER_KEYWORDS.items():
-        if key in (replay_buffer_kwargs or {}) and replay_buffer_kwargs[key] != learning[argument]:
+    for key in _BUFFER_KEYWORDS:
+        if key in (replay_buffer_kwargs or {}) and replay_buffer_kwargs[key] != learning[key]:
             raise ValueError(
-                f"replay_buffer_kwargs[{key!r}]={replay_buffer_kwargs[key]!r} contradicts {argument}={learning[argument]!r}, "
-                f"which sets it: pass {argument}={replay_buffer_kwargs[key]!r} instead"
+                f"replay_buffer_kwargs[{key!r}]={replay_buffer_kwargs[key]!r} contradicts {key}={learning[key]!r}, "
+                f"which sets it: pass {key}={replay_buffer_kwargs[key]!r} instead"
             )
     if seed is not None and not (_is_int(seed) and 0 <= seed < 2**32):
         raise ValueError(f"seed must be None or an integer in [0, 2**32 - 1], got {seed!r}")
@@ -165,3 +159,23 @@ def check_total_timesteps(value: Any) -> int:
     if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
         value = int(value)
     return check_int("total_timesteps", value, 0)
+
+
+def warn_if_learn_does_not_train(gradient_steps: int, total_timesteps: int, learning_starts: int) -> None:
+    """``learn``'s warnings for a run that never updates the network: ``gradient_steps=0`` (SB3's collect-only
+    setting), or a run that ends before ``learning_starts``."""
+    if gradient_steps == 0:
+        warnings.warn(
+            "gradient_steps=0: learn() collects transitions but never updates the network (SB3's collect-only "
+            "setting). Pass gradient_steps=-1 (one update per env step collected) or a positive number to train.",
+            UserWarning,
+            stacklevel=4,
+        )
+    if total_timesteps <= learning_starts:
+        warnings.warn(
+            f"learn() ends at step {total_timesteps}, which does not exceed learning_starts={learning_starts}: "
+            f"the model only collects uniformly random transitions (gradient steps start after step "
+            f"{learning_starts}). Raise total_timesteps or lower learning_starts.",
+            UserWarning,
+            stacklevel=4,
+        )

@@ -11,7 +11,9 @@ import torch as th
 from gymnasium import spaces
 from stable_baselines3.common.buffers import NStepReplayBuffer, ReplayBuffer
 from stable_baselines3.common.type_aliases import TensorDict
+from stable_baselines3.common.utils import LinearSchedule
 from stable_baselines3.common.vec_env import VecNormalize
+from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
 from sb3_gqn.common.arguments import check_int, check_number
 from sb3_gqn.common.nstep_dict import NStepDictReplayBuffer
@@ -61,10 +63,11 @@ class PrioritizedSampling:
     :param n_steps: Number of steps to accumulate rewards for n-step returns
     :param gamma: Discount factor for future rewards
     :param alpha: priority exponent: a TD error ``|td|`` gives priority ``(|td| + epsilon) ** alpha``
-        (0: uniform sampling)
-    :param beta: importance-sampling exponent (0: no correction, 1: full correction); may be changed
-        between calls to ``sample`` (GQN anneals it when asked to)
+        (0: uniform sampling); DecQN: 0.6
+    :param beta: importance-sampling exponent (0: no correction, 1: full correction); DecQN: 0.2
     :param epsilon: added to ``|td|`` so that no transition gets priority zero
+    :param beta_annealing: anneal beta linearly from ``beta`` to 1 over training (Schaul et al.; :meth:`anneal_beta`,
+        which GQN calls before every update) instead of keeping it constant (DecQN)
     """
 
     #: the n-step buffer class whose ``_get_samples`` computes the samples (set by the concrete classes)
@@ -87,6 +90,7 @@ class PrioritizedSampling:
         alpha: float = 0.6,
         beta: float = 0.2,
         epsilon: float = 1e-6,
+        beta_annealing: bool = False,
     ):
         self._check_observation_space(observation_space)
         if optimize_memory_usage:
@@ -97,10 +101,7 @@ class PrioritizedSampling:
         check_int("buffer_size", buffer_size, 1)
         check_int("n_steps", n_steps, 1)
         check_number("gamma", gamma, 0.0, 1.0, low_open=True)
-        if not alpha >= 0:
-            raise ValueError(f"alpha (priority exponent) must be >= 0, got {alpha}")
-        if not epsilon > 0:
-            raise ValueError(f"epsilon must be > 0 so that no priority is zero, got {epsilon}")
+        check_priority_settings(dict(alpha=alpha, beta=beta, epsilon=epsilon, beta_annealing=beta_annealing), "")
         super().__init__(  # type: ignore[call-arg]
             buffer_size,
             observation_space,
@@ -112,11 +113,21 @@ class PrioritizedSampling:
             n_steps=n_steps,
             gamma=gamma,
         )
-        self.alpha = alpha
+        self.alpha = float(alpha)
         self.beta = beta
-        self.epsilon = epsilon
+        self.epsilon = float(epsilon)
+        #: beta's value at the start of training (:meth:`anneal_beta` moves :attr:`beta` from it to 1)
+        self.initial_beta = float(beta)
+        self.beta_annealing = bool(beta_annealing)
         self.priorities = SumTree(self.buffer_size * self.n_envs)
         self.max_priority = 1.0
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # Buffers pickled by 0.2 and earlier, whose model kept beta's schedule: beta as saved, until the model that
+        # loads them (GQN.load_replay_buffer) gives them its own schedule
+        state.setdefault("initial_beta", state["_beta"])
+        state.setdefault("beta_annealing", False)
+        self.__dict__.update(state)
 
     def _check_observation_space(self, observation_space: spaces.Space) -> None:
         """Refuse an observation space the n-step buffer cannot store."""
@@ -131,6 +142,12 @@ class PrioritizedSampling:
         if not 0 <= value <= 1:
             raise ValueError(f"beta (importance-sampling exponent) must lie in [0, 1], got {value}")
         self._beta = float(value)
+
+    def anneal_beta(self, progress_remaining: float) -> None:
+        """Set :attr:`beta` for the training progress: with ``beta_annealing`` from :attr:`initial_beta` when
+        ``progress_remaining`` is 1 linearly to 1 when it is 0 (Schaul et al.), else :attr:`initial_beta`."""
+        final = 1.0 if self.beta_annealing else self.initial_beta
+        self.beta = LinearSchedule(self.initial_beta, final, end_fraction=1.0)(progress_remaining)
 
     def add(
         self,
@@ -255,33 +272,95 @@ class PrioritizedDictReplayBuffer(PrioritizedSampling, NStepDictReplayBuffer):
             raise ValueError(f"PrioritizedDictReplayBuffer needs a Dict observation space, got {observation_space}")
 
 
-def default_replay_buffer_class(
+#: The prioritized buffer's own settings in ``replay_buffer_kwargs`` (:class:`PrioritizedSampling`'s parameters)
+PRIORITY_SETTINGS = ("alpha", "beta", "epsilon", "beta_annealing")
+#: The key of ``replay_buffer_kwargs`` that GQN reads itself (the buffer never sees it): ``False`` replaces the
+#: prioritized buffer GQN chooses by a uniform one
+PRIORITIZED = "prioritized"
+
+
+def check_priority_settings(settings: dict[str, Any], prefix: str = "replay_buffer_kwargs") -> None:
+    """The prioritized buffer's settings among ``settings``: ``alpha`` a finite number >= 0, ``beta`` in [0, 1],
+    ``epsilon`` > 0 and ``beta_annealing`` a bool. ``ValueError`` naming the setting (``replay_buffer_kwargs['alpha']``
+    with the default ``prefix``)."""
+
+    def name(key: str) -> str:
+        return f"{prefix}[{key!r}]" if prefix else key
+
+    if "alpha" in settings:
+        check_number(name("alpha"), settings["alpha"], 0.0)
+    if "beta" in settings:
+        check_number(name("beta"), settings["beta"], 0.0, 1.0)
+    if "epsilon" in settings:
+        check_number(name("epsilon"), settings["epsilon"], 0.0, low_open=True)
+    for key in ("beta_annealing", PRIORITIZED):
+        if key in settings and not isinstance(settings[key], (bool, np.bool_)):
+            raise ValueError(f"{name(key)} must be True or False, got {settings[key]!r}")
+
+
+#: The keys GQN's default buffers take in ``replay_buffer_kwargs`` (``n_steps`` and ``gamma`` must match GQN's own)
+DEFAULT_BUFFER_KEYS = (PRIORITIZED, *PRIORITY_SETTINGS, "handle_timeout_termination", "n_steps", "gamma")
+
+
+def check_replay_buffer_kwargs(replay_buffer_class: type[ReplayBuffer] | None, replay_buffer_kwargs: dict[str, Any]) -> None:
+    """``replay_buffer_kwargs`` checked before a buffer is built: ``prioritized`` and the prioritized buffer's settings
+    (:func:`check_priority_settings`); for GQN's default buffer (no class given) only the keys it takes
+    (:data:`DEFAULT_BUFFER_KEYS`), without prioritized replay's settings when ``prioritized=False``; with a class given,
+    ``prioritized`` that agrees with it. ``ValueError`` naming the key."""
+    check_priority_settings(replay_buffer_kwargs)
+    prioritized = replay_buffer_kwargs.get(PRIORITIZED)
+    if replay_buffer_class is not None:
+        is_prioritized = issubclass(replay_buffer_class, PrioritizedSampling)
+        if prioritized is not None and prioritized != is_prioritized:
+            kind = "samples by priority" if is_prioritized else "samples uniformly"
+            raise ValueError(
+                f"replay_buffer_kwargs['prioritized']={prioritized} contradicts replay_buffer_class="
+                f"{replay_buffer_class.__name__}, which {kind}: leave out one of them"
+            )
+        return
+    unknown = sorted(str(key) for key in replay_buffer_kwargs if key not in DEFAULT_BUFFER_KEYS)
+    if unknown:
+        raise ValueError(
+            f"replay_buffer_kwargs has no setting {', '.join(map(repr, unknown))} for GQN's default replay buffer: its "
+            f"keys are {DEFAULT_BUFFER_KEYS}"
+        )
+    settings = [key for key in PRIORITY_SETTINGS if key in replay_buffer_kwargs]
+    if prioritized is False and settings:
+        raise ValueError(f"replay_buffer_kwargs sets {settings} of prioritized replay, and prioritized=False: leave them out")
+
+
+def replay_buffer_settings(
     replay_buffer_class: type[ReplayBuffer] | None,
+    replay_buffer_kwargs: dict[str, Any],
     dict_observations: bool,
-    prioritized: bool,
     n_steps: int,
     gamma: float,
-    alpha: float,
-    beta: float,
-) -> tuple[type[ReplayBuffer] | None, dict[str, Any]]:
-    """The replay buffer class GQN trains with, and the keyword arguments it needs beyond SB3's.
+) -> tuple[type[ReplayBuffer] | None, dict[str, Any], int]:
+    """The replay buffer class GQN trains with, the keyword arguments it is built with (``replay_buffer_kwargs``
+    without GQN's own key ``"prioritized"``, plus the n-step return where the class computes one) and the n-step
+    return's length.
 
-    With ``prioritized`` and no class given: :class:`PrioritizedReplayBuffer` (:class:`PrioritizedDictReplayBuffer` for
-    ``Dict`` observations) with the n-step return and the priority exponents. Without: ``None`` (SB3 then picks its
-    ``NStepReplayBuffer`` or ``ReplayBuffer``), or :class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer` for
-    ``Dict`` observations with ``n_steps > 1`` (SB3 has no n-step ``Dict`` buffer). A class given is kept.
+    No class given: :class:`PrioritizedReplayBuffer` (:class:`PrioritizedDictReplayBuffer` for ``Dict``
+    observations), or with ``replay_buffer_kwargs["prioritized"] = False`` uniform replay: ``None`` (SB3 then picks
+    its ``NStepReplayBuffer`` or ``ReplayBuffer``), or :class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer` for
+    ``Dict`` observations with ``n_steps > 1`` (SB3 has no n-step ``Dict`` buffer). A class given is kept; SB3's
+    ``HerReplayBuffer`` relabels single transitions and samples them itself: one-step returns, uniform sampling.
 
-    :raises ValueError: when ``prioritized`` and the class given does not sample by priority
+    :raises ValueError: as :func:`check_replay_buffer_kwargs`
     """
-    if prioritized:
-        if replay_buffer_class is None:
-            chosen = PrioritizedDictReplayBuffer if dict_observations else PrioritizedReplayBuffer
-            return chosen, dict(n_steps=n_steps, gamma=gamma, alpha=alpha, beta=beta)
-        if not issubclass(replay_buffer_class, PrioritizedSampling):
-            raise ValueError(
-                f"replay_buffer_class={replay_buffer_class.__name__} is not prioritized: pass "
-                "prioritized_replay=False to train with it uniformly"
-            )
-    elif replay_buffer_class is None and dict_observations and n_steps > 1:
-        return NStepDictReplayBuffer, dict(n_steps=n_steps, gamma=gamma)
-    return replay_buffer_class, {}
+    if replay_buffer_class is not None and issubclass(replay_buffer_class, HerReplayBuffer):
+        return replay_buffer_class, {k: v for k, v in replay_buffer_kwargs.items() if k != PRIORITIZED}, 1
+    check_replay_buffer_kwargs(replay_buffer_class, replay_buffer_kwargs)
+    kwargs = dict(replay_buffer_kwargs)
+    prioritized = kwargs.pop(PRIORITIZED, True)
+    n_step = {"n_steps": n_steps, "gamma": gamma}
+    if replay_buffer_class is not None:
+        if issubclass(replay_buffer_class, (PrioritizedSampling, NStepReplayBuffer, NStepDictReplayBuffer)):
+            kwargs.update(n_step)
+        return replay_buffer_class, kwargs, n_steps
+    if not prioritized:
+        if dict_observations and n_steps > 1:
+            return NStepDictReplayBuffer, {**kwargs, **n_step}, n_steps
+        return None, kwargs, n_steps
+    chosen = PrioritizedDictReplayBuffer if dict_observations else PrioritizedReplayBuffer
+    return chosen, {**kwargs, **n_step}, n_steps

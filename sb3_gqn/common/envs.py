@@ -98,6 +98,15 @@ def resolve_env(env: gym.Env | VecEnv | str | None) -> gym.Env | VecEnv | None:
     return env
 
 
+def check_policy_fits(policy: Any, observation_space: spaces.Space) -> None:
+    """Refuse ``policy="MlpPolicy"`` for a ``Dict`` observation (SB3's flatten extractor would fail later, unclearly)."""
+    if policy == "MlpPolicy" and isinstance(observation_space, spaces.Dict):
+        raise ValueError(
+            f"policy='MlpPolicy' needs a flat observation, but this env's is a Dict ({list(observation_space)}): use "
+            "'MultiInputPolicy', or flatten it (sb3_gqn.common.envs.make_env(env_id) flattens)"
+        )
+
+
 def check_action_space(action_space: spaces.Space) -> None:
     """Raise a clear error unless GQN can act in ``action_space``.
 

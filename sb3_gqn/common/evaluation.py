@@ -164,13 +164,13 @@ def growth_columns(model: Any) -> dict[str, Any]:
 @contextmanager
 def decoded_as(model: Any, decoding: str) -> Iterator[Any]:
     """Inside the block, ``model``'s deterministic ``predict`` uses ``decoding`` at that decoding's default
-    temperature (a model with GQN's ``decoding`` and ``decoding_temperature`` attributes); both are restored after."""
-    saved = model.decoding, model.decoding_temperature
-    model.decoding, model.decoding_temperature = decoding, None
+    temperature (a model with GQN's ``decoding`` and ``decoding_kwargs`` attributes); both are restored after."""
+    saved = model.decoding, model.decoding_kwargs
+    model.decoding, model.decoding_kwargs = decoding, {}
     try:
         yield model
     finally:
-        model.decoding, model.decoding_temperature = saved
+        model.decoding, model.decoding_kwargs = saved
 
 
 class LearningCurveCallback(BaseCallback):

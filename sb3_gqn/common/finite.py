@@ -57,3 +57,21 @@ def as_batch(observation: np.ndarray | dict[str, np.ndarray] | Any, observation_
     array = np.asarray(observation)
     own_dims = len(observation_space.shape or ())
     return array if array.ndim > own_dims else array[None]
+
+
+def check_finite_transition(
+    reward: np.ndarray,
+    new_obs: np.ndarray | dict[str, np.ndarray],
+    infos: list[dict[str, Any]],
+    step: int,
+    observation_space: spaces.Space,
+) -> None:
+    """Refuse a step's non-finite rewards and observations (the terminal observations in ``infos`` too) before they
+    reach the replay buffer, where they would poison every Q-value: ``ValueError`` naming the step and the value."""
+    if not np.all(np.isfinite(reward)):
+        raise ValueError(f"The env returned a non-finite reward {reward} at step {step}")
+    check_finite_observation(new_obs, f"the env's step {step}")
+    for env_index, info in enumerate(infos):
+        if info.get("terminal_observation") is not None:
+            where = f"the env's step {step} (terminal observation of env {env_index})"
+            check_finite_observation(as_batch(info["terminal_observation"], observation_space), where)

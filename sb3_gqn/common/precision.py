@@ -15,6 +15,7 @@ exploration, evaluation) and the exports stay float32: at batch 1 an action cost
 from __future__ import annotations
 
 import functools
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -61,6 +62,22 @@ def resolve_precision(precision: str, device: th.device | str) -> str:
     if precision == "auto":
         return "bf16" if has_bf16_matrix_units(device) else "fp32"
     return precision
+
+
+def checked_precision(precision: str, device: th.device | str) -> str:
+    """GQN's ``precision`` checked (one of :data:`PRECISIONS`, ``ValueError`` naming it) and resolved for ``device``
+    (:func:`resolve_precision`); ``"bf16"`` on a device without bfloat16 matrix units warns that it runs no faster."""
+    if precision not in PRECISIONS:
+        raise ValueError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+    if precision == "bf16" and not has_bf16_matrix_units(device):
+        warnings.warn(
+            f"precision='bf16' on {device}, which has no bfloat16 matrix units: the updates round their matrix "
+            "products' operands to bfloat16 on float32 kernels (the same arithmetic as on bfloat16 hardware, no "
+            "faster). precision='fp32' or 'auto' train in float32 here.",
+            UserWarning,
+            stacklevel=3,
+        )
+    return resolve_precision(precision, device)
 
 
 def round_to_bf16(tensor: th.Tensor) -> th.Tensor:

@@ -8,19 +8,37 @@ from typing import Any
 import torch as th
 from torch import nn
 
-#: The torso GQN and DecQN build unless ``policy_kwargs`` choose another: LayerNorm in each hidden block and ELU
-#: (DecQN's default torso). ``GQNPolicy``'s own defaults stay the plain ReLU MLP that models saved by 0.2.0 and
-#: earlier were built with, so those load as saved.
+#: The torso GQN's and DecQN's policies build unless their options choose another: LayerNorm after the first layer and
+#: ELU (DecQN's default torso)
 DEFAULT_TORSO: dict[str, Any] = {"layer_norm": True, "activation_fn": nn.ELU}
+#: The torso of a model file saved by 0.2.0 or earlier for the options its ``policy_kwargs`` do not name: the plain
+#: ReLU MLP, the policies' default then (GQN writes the torso into ``policy_kwargs`` since, so its files name it)
+SAVED_BEFORE_DEFAULT_TORSO: dict[str, Any] = {"layer_norm": False, "activation_fn": nn.ReLU}
+#: What the residual torso (``residual_layer_norm=True``), which fixes its own layers, records for the two options:
+#: the only values it accepts for them
+RESIDUAL_TORSO_OPTIONS: dict[str, Any] = {"layer_norm": False, "activation_fn": nn.ReLU}
 
 
-def with_default_torso(policy_kwargs: dict[str, Any] | None) -> dict[str, Any]:
-    """A copy of ``policy_kwargs`` with :data:`DEFAULT_TORSO`'s entries where they do not choose their own; unchanged
-    when they choose the residual torso (``residual_layer_norm=True``), which brings its own."""
+def with_default_torso(policy_kwargs: dict[str, Any] | None, default: dict[str, Any] = DEFAULT_TORSO) -> dict[str, Any]:
+    """A copy of ``policy_kwargs`` with ``default``'s entries (:data:`DEFAULT_TORSO`; for a saved model's
+    :data:`SAVED_BEFORE_DEFAULT_TORSO`) where they do not choose their own; unchanged when they choose the residual
+    torso (``residual_layer_norm=True``), which brings its own."""
     chosen = dict(policy_kwargs or {})
     if chosen.get("residual_layer_norm"):
         return chosen
-    return {**DEFAULT_TORSO, **chosen}
+    return {**default, **chosen}
+
+
+def torso_options(
+    layer_norm: bool | None, activation_fn: type[nn.Module] | None, residual_layer_norm: bool = False
+) -> tuple[bool, type[nn.Module]]:
+    """``layer_norm`` and ``activation_fn`` with ``None`` (not chosen) resolved: :data:`DEFAULT_TORSO`'s, or with
+    ``residual_layer_norm`` :data:`RESIDUAL_TORSO_OPTIONS`."""
+    defaults = RESIDUAL_TORSO_OPTIONS if residual_layer_norm else DEFAULT_TORSO
+    return (
+        defaults["layer_norm"] if layer_norm is None else layer_norm,
+        defaults["activation_fn"] if activation_fn is None else activation_fn,
+    )
 
 
 def variance_scaling_uniform_(linear: nn.Linear, scale: float = 1.0 / 3.0) -> nn.Linear:

@@ -22,7 +22,7 @@ from stable_baselines3.common.utils import get_parameters_by_name, polyak_update
 from torch import nn
 
 from sb3_gqn.common.masking import masked_argmax
-from sb3_gqn.common.torsos import DecoupledMLP
+from sb3_gqn.common.torsos import DecoupledMLP, torso_options
 from sb3_gqn.gqn.q_network import DecoupledQNetwork, critics_maximum, decoupled_action_shape
 
 __all__ = [
@@ -35,8 +35,30 @@ __all__ = [
     "critics_maximum",
 ]
 
-# Layers whose output depends on ``module.training`` (SB3's own policies switch modes for these).
-_MODE_DEPENDENT_LAYERS = (nn.modules.dropout._DropoutNd, nn.modules.batchnorm._NormBase)
+#: Layers whose output depends on ``module.training`` (SB3's own policies switch modes for these): torch's dropout layers
+#: and the normalizations that keep running statistics (tests/test_acting.py checks that the list holds every such
+#: layer torch has)
+MODE_DEPENDENT_LAYERS: tuple[type[nn.Module], ...] = (
+    nn.Dropout,
+    nn.Dropout1d,
+    nn.Dropout2d,
+    nn.Dropout3d,
+    nn.AlphaDropout,
+    nn.FeatureAlphaDropout,
+    nn.BatchNorm1d,
+    nn.BatchNorm2d,
+    nn.BatchNorm3d,
+    nn.LazyBatchNorm1d,
+    nn.LazyBatchNorm2d,
+    nn.LazyBatchNorm3d,
+    nn.SyncBatchNorm,
+    nn.InstanceNorm1d,
+    nn.InstanceNorm2d,
+    nn.InstanceNorm3d,
+    nn.LazyInstanceNorm1d,
+    nn.LazyInstanceNorm2d,
+    nn.LazyInstanceNorm3d,
+)
 
 
 class GQNPolicy(BasePolicy):
@@ -49,8 +71,9 @@ class GQNPolicy(BasePolicy):
     :param action_space: ``Discrete`` or ``MultiDiscrete`` action space
     :param lr_schedule: Learning rate schedule (could be constant)
     :param net_arch: hidden layer sizes (default ``[512, 512]``)
-    :param activation_fn: Activation function
-    :param layer_norm: LayerNorm in each hidden block
+    :param activation_fn: Activation function (``None``: :data:`~sb3_gqn.common.torsos.DEFAULT_TORSO`'s, ELU)
+    :param layer_norm: LayerNorm and tanh after the first layer (``None``: :data:`~sb3_gqn.common.torsos.DEFAULT_TORSO`'s,
+        on)
     :param residual: residual connections between equal-size hidden blocks
     :param residual_layer_norm: DecQN's residual torso as its reference runs it (``LayerNorm(x + MLP(x))`` + ELU,
         see :class:`~sb3_gqn.common.torsos.ResidualLayerNormMLP`) and its head initialization; excludes ``layer_norm``,
@@ -84,8 +107,8 @@ class GQNPolicy(BasePolicy):
         action_space: spaces.Space,
         lr_schedule: Schedule,
         net_arch: list[int] | None = None,
-        activation_fn: type[nn.Module] = nn.ReLU,
-        layer_norm: bool = False,
+        activation_fn: type[nn.Module] | None = None,
+        layer_norm: bool | None = None,
         residual: bool = False,
         residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = FlattenExtractor,
@@ -108,8 +131,7 @@ class GQNPolicy(BasePolicy):
             normalize_images=normalize_images,
         )
         self.net_arch = [512, 512] if net_arch is None else list(net_arch)
-        self.activation_fn = activation_fn
-        self.layer_norm = layer_norm
+        self.layer_norm, self.activation_fn = torso_options(layer_norm, activation_fn, residual_layer_norm)
         self.residual = residual
         self.residual_layer_norm = residual_layer_norm  # its option errors come from DecoupledQNetwork in _build
         if not isinstance(n_critics, int) or n_critics < 1:
@@ -145,7 +167,9 @@ class GQNPolicy(BasePolicy):
         for (online, _), acting in zip(self.critics, self.acting_q_nets):
             acting.load_state_dict(online.state_dict())
             acting.set_training_mode(False)
-        self._mode_dependent = any(isinstance(module, _MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
+        self._mode_dependent = any(isinstance(module, MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
+        # every module of the online networks, whose training flags set_training_mode sets
+        self._online_modules = [module for online, _ in self.critics for module in online.modules()]
         # Only the online networks are optimized (the target nets' parameters stay out of the optimizer)
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.online_parameters(),
@@ -174,11 +198,19 @@ class GQNPolicy(BasePolicy):
         """One Polyak step of the averaged acting copies: ``theta_acting <- (1 - tau) theta_acting + tau theta_online``
         for every parameter; running statistics (batch norm) are copied."""
         for (online, _), acting in zip(self.critics, self.acting_q_nets, strict=True):
-            # theta_acting + tau (theta_online - theta_acting) for all tensors in one call: half the time of SB3's
-            # polyak_update (two kernels per tensor), ~0.14 ms on cartpole's 270k parameters
-            th._foreach_lerp_(list(acting.parameters()), list(online.parameters()), tau)
+            # theta_acting + tau (theta_online - theta_acting), one kernel per tensor: half the time of SB3's
+            # polyak_update (two kernels per tensor)
+            for acting_parameter, online_parameter in zip(acting.parameters(), online.parameters(), strict=True):
+                acting_parameter.lerp_(online_parameter, tau)
             if self._mode_dependent:  # only then are there running statistics (walking the state dict costs ~0.3 ms)
                 polyak_update(get_parameters_by_name(online, ["running_"]), get_parameters_by_name(acting, ["running_"]), 1.0)
+
+    def running_statistics(self) -> tuple[list[th.Tensor], list[th.Tensor]]:
+        """The running statistics (batch norm) of every critic's online and of its target network, in the same order
+        (empty lists for the default torsos)."""
+        online = [stat for network, _ in self.critics for stat in get_parameters_by_name(network, ["running_"])]
+        target = [stat for _, network in self.critics for stat in get_parameters_by_name(network, ["running_"])]
+        return online, target
 
     def greedy_utilities(self, obs: PyTorchObs, online: bool = False) -> th.Tensor:
         """The utilities greedy actions maximize: the acting critic's (:meth:`acting_networks`; the online one
@@ -271,26 +303,25 @@ class GQNPolicy(BasePolicy):
         return super().load_state_dict(state, strict, assign)
 
     def set_training_mode(self, mode: bool) -> None:
-        """Put the online network in training or evaluation mode (the target stays in eval mode).
+        """Put the online networks in training or evaluation mode (the targets and the averaged acting copies stay in
+        evaluation mode), as ``nn.Module.train`` does on each of them.
 
-        SB3 switches modes around every rollout and every ``train`` call. Walking the module tree costs ~0.1 ms, so it
-        only happens when the mode changes and the network has layers that depend on it (:attr:`mode_dependent`);
-        otherwise only the policy's and the online network's own flags change.
+        SB3 switches modes around every rollout and every ``train`` call: only a change of mode does anything, and it
+        sets the ``training`` flag of every module of the online networks from a list made once (``nn.Module.train``
+        walks the module tree, about twice the time).
         """
-        if self.q_net.training != mode or self.training != mode:
-            for online, _ in self.critics:
-                if self._mode_dependent:
-                    online.set_training_mode(mode)
-                else:
-                    online.training = mode
+        if self.training != mode or self.q_net.training != mode:
+            for module in self._online_modules:
+                module.training = mode
             self.training = mode
 
     @property
     def device(self) -> th.device:
-        """The networks' device, read from the mask buffer (SB3's property iterates over the parameters: ~5 us a call,
-        paid on every env step)."""
-        mask = self._buffers.get("active_bins_mask")
-        return super().device if mask is None else mask.device
+        """The networks' device, read from the mask buffer (SB3's property iterates over the parameters)."""
+        try:
+            return self.active_bins_mask.device
+        except AttributeError:  # while the policy is being built, before the buffer exists
+            return super().device
 
     @property
     def mode_dependent(self) -> bool:
@@ -378,8 +409,8 @@ class CnnPolicy(GQNPolicy):
         action_space: spaces.Space,
         lr_schedule: Schedule,
         net_arch: list[int] | None = None,
-        activation_fn: type[nn.Module] = nn.ReLU,
-        layer_norm: bool = False,
+        activation_fn: type[nn.Module] | None = None,
+        layer_norm: bool | None = None,
         residual: bool = False,
         residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = NatureCNN,
@@ -418,8 +449,8 @@ class MultiInputPolicy(GQNPolicy):
         action_space: spaces.Space,
         lr_schedule: Schedule,
         net_arch: list[int] | None = None,
-        activation_fn: type[nn.Module] = nn.ReLU,
-        layer_norm: bool = False,
+        activation_fn: type[nn.Module] | None = None,
+        layer_norm: bool | None = None,
         residual: bool = False,
         residual_layer_norm: bool = False,
         features_extractor_class: type[BaseFeaturesExtractor] = CombinedExtractor,

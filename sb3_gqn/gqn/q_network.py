@@ -18,7 +18,13 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor, Flatten
 from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
-from sb3_gqn.common.torsos import DecoupledMLP, ResidualLayerNormMLP, variance_scaling_uniform_
+from sb3_gqn.common.torsos import (
+    RESIDUAL_TORSO_OPTIONS,
+    DecoupledMLP,
+    ResidualLayerNormMLP,
+    torso_options,
+    variance_scaling_uniform_,
+)
 
 __all__ = ["DecoupledQNetwork", "check_residual_layer_norm_options", "critics_maximum", "decoupled_action_shape"]
 
@@ -51,13 +57,14 @@ def decoupled_action_shape(action_space: spaces.Space) -> tuple[int, int]:
 
 
 def check_residual_layer_norm_options(layer_norm: bool, residual: bool, activation_fn: type[nn.Module]) -> None:
-    """``residual_layer_norm`` is a whole torso: raise ``ValueError`` for the options it would otherwise ignore."""
-    if layer_norm or residual:
+    """``residual_layer_norm`` is a whole torso: raise ``ValueError`` for the options it would otherwise ignore (it
+    accepts only :data:`~sb3_gqn.common.torsos.RESIDUAL_TORSO_OPTIONS`, what it records when they are not chosen)."""
+    if layer_norm != RESIDUAL_TORSO_OPTIONS["layer_norm"] or residual:
         raise ValueError("residual_layer_norm=True is a torso of its own: leave layer_norm and residual False")
-    if activation_fn is not nn.ReLU:
+    if activation_fn is not RESIDUAL_TORSO_OPTIONS["activation_fn"]:
         raise ValueError(
             "residual_layer_norm=True fixes its activations (ReLU inside each block, ELU after the torso): "
-            f"leave activation_fn at its default, got {activation_fn.__name__}"
+            f"leave activation_fn unset, got {activation_fn.__name__}"
         )
 
 
@@ -81,8 +88,9 @@ class DecoupledQNetwork(BasePolicy):
     :param features_extractor: shared features extractor
     :param features_dim: its output dimension
     :param net_arch: hidden layer sizes (default ``[512, 512]``)
-    :param activation_fn: activation function
-    :param layer_norm: LayerNorm in each hidden block
+    :param activation_fn: activation function (``None``: :data:`~sb3_gqn.common.torsos.DEFAULT_TORSO`'s, ELU)
+    :param layer_norm: LayerNorm and tanh after the first layer (``None``: :data:`~sb3_gqn.common.torsos.DEFAULT_TORSO`'s,
+        on)
     :param residual: residual connections between equal-size hidden blocks
     :param residual_layer_norm: DecQN's residual torso as its reference runs it
         (:class:`~sb3_gqn.common.torsos.ResidualLayerNormMLP`: ``LayerNorm(x + MLP(x))`` + ELU, ``net_arch = [width] * (1 +
@@ -98,12 +106,13 @@ class DecoupledQNetwork(BasePolicy):
         features_extractor: BaseFeaturesExtractor,
         features_dim: int,
         net_arch: list[int] | None = None,
-        activation_fn: type[nn.Module] = nn.ReLU,
-        layer_norm: bool = False,
+        activation_fn: type[nn.Module] | None = None,
+        layer_norm: bool | None = None,
         residual: bool = False,
         residual_layer_norm: bool = False,
         normalize_images: bool = True,
     ):
+        layer_norm, activation_fn = torso_options(layer_norm, activation_fn, residual_layer_norm)
         super().__init__(
             observation_space,
             action_space,

@@ -1,5 +1,6 @@
 """What GQN adds to SB3's model and replay-buffer files: a clear error for another algorithm's file or the other
-kind of replay buffer, and replay-buffer files that hold only the filled rows."""
+kind of replay buffer, replay-buffer files that hold only the filled rows, and the files of earlier releases read as
+they were saved (:data:`SAVED_BEFORE_ATTRIBUTE`, :func:`upgrade_saved_settings`)."""
 
 from __future__ import annotations
 
@@ -16,11 +17,32 @@ from stable_baselines3.common.save_util import load_from_pkl, save_to_pkl
 from stable_baselines3.common.vec_env import VecEnv
 from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
-from sb3_gqn.common.buffers import PrioritizedSampling
+from sb3_gqn.common.buffers import PRIORITIZED, PrioritizedSampling
 from sb3_gqn.common.compact_buffer import compact, expand
-from sb3_gqn.gqn.growth.schedules import bin_levels_from, checked_bins
+from sb3_gqn.gqn.growth.schedules import (
+    AdaptiveGrowth,
+    bin_levels_from,
+    check_growth_keys,
+    checked_bins,
+    growth_settings,
+)
+from sb3_gqn.gqn.settings import DEPRECATED_KEYWORDS, GROUPS, regroup_deprecated
 
 SavedPath = str | pathlib.Path | io.BufferedIOBase
+
+#: What a model file saved before an attribute existed trained with, set by ``load`` when the file lacks it (not the
+#: class defaults, which may change): the argmax decoding (files of 0.1.0), float32 updates (0.2.0 and earlier)
+SAVED_BEFORE_ATTRIBUTE: dict[str, Any] = {"decoding": "argmax", "precision": "fp32"}
+#: The attribute under which ``load`` hands the 0.2 keywords it was given, regrouped, to ``_setup_model``
+SETTINGS_GIVEN_AT_LOAD = "_settings_given_at_load"
+#: Attributes of 0.2 files that 0.3 keeps elsewhere and drops (the replay buffer's class says whether it prioritizes;
+#: the buffer anneals its own beta)
+_DROPPED_ATTRIBUTES = (
+    "prioritized_replay",
+    "priority_exponent",
+    "importance_sampling_exponent",
+    "importance_sampling_schedule",
+)
 
 
 def saved_data(path: SavedPath) -> dict[str, Any] | None:
@@ -141,6 +163,40 @@ def check_buffer_fits(path: SavedPath, loaded: ReplayBuffer, current: ReplayBuff
         )
 
 
+def upgrade_saved_settings(attributes: dict[str, Any]) -> None:
+    """A model's attributes as SB3's ``load`` set them, in place: those of a file saved by 0.2 or earlier moved to
+    where 0.3 keeps them (``decoding_temperature`` into ``decoding_kwargs``, ``importance_sampling_annealing`` into
+    ``replay_buffer_kwargs``), then the settings given to ``load`` applied: ``decoding_kwargs`` and
+    ``replay_buffer_kwargs`` replace the saved ones (SB3's rule for a keyword of ``load``), ``growth_kwargs`` change
+    the warm start and the adaptive schedule's settings (its state goes on), and 0.2 keywords given to ``load``
+    update their groups. A 0.3 file loaded without settings is left as it is; so is a model just built."""
+    given = attributes.pop(SETTINGS_GIVEN_AT_LOAD, {})
+    # save() stores the event lists as JSON, which turns their (step, bins) tuples into lists
+    for name in ("growth_events", "deployments"):
+        attributes[name] = [(int(step), int(bins)) for step, bins in attributes[name]]
+    temperature = attributes.pop("decoding_temperature", None)
+    if temperature is not None:
+        attributes["decoding_kwargs"] = {"temperature": temperature, **attributes["decoding_kwargs"]}
+    annealing = attributes.pop("importance_sampling_annealing", False)
+    prioritized = attributes.get("prioritized_replay", False)
+    for name in _DROPPED_ATTRIBUTES:
+        attributes.pop(name, None)
+    if annealing and prioritized:
+        attributes["replay_buffer_kwargs"] = {"beta_annealing": True, **attributes["replay_buffer_kwargs"]}
+    for group in ("decoding_kwargs", "replay_buffer_kwargs"):
+        attributes[group] = {**attributes[group], **given.get(group, {})}
+    growth = {**(attributes.pop("growth_kwargs", None) or {}), **given.get("growth_kwargs", {})}
+    if growth:
+        schedule: AdaptiveGrowth | None = attributes.get("growth_schedule")
+        settings = {key: value for key, value in growth.items() if key != "init"}
+        attributes["growth_init"], _ = growth_settings(None, {"init": growth.get("init", attributes["growth_init"])})
+        check_growth_keys(settings, AdaptiveGrowth.SETTINGS)
+        if schedule is not None:
+            schedule.change_settings(**settings)
+        else:
+            AdaptiveGrowth(**settings)  # checked, as the constructor checks them for every schedule
+
+
 class SavedFiles:
     """Mixed into :class:`~sb3_gqn.gqn.gqn.GQN` before SB3's ``OffPolicyAlgorithm``."""
 
@@ -152,10 +208,25 @@ class SavedFiles:
     @classmethod
     def load(cls, path: SavedPath, *args: Any, **kwargs: Any) -> Any:
         """SB3's ``load``, after checking that the file holds a model of this class (GQN, or DecQN for
-        ``DecQN.load``; a GQN file with static bins loads into either)."""
+        ``DecQN.load``; a GQN file with static bins loads into either). Keyword arguments set the model's settings as
+        in SB3; ``growth_kwargs`` change the warm start and the adaptive schedule's settings, whose state goes on, and
+        the 0.2 keywords (``growth_patience=3``, ...) still work, with a ``DeprecationWarning``
+        (:func:`upgrade_saved_settings`)."""
         check_model_file(path)
+        deprecated = {key: kwargs.pop(key) for key in list(kwargs) if key in DEPRECATED_KEYWORDS}
+        if deprecated:
+            given = {group: kwargs.get(group) for group in GROUPS}
+            regrouped = regroup_deprecated(deprecated, given, f"{cls.__name__}.load")
+            # a group given to load takes them; otherwise they update the file's group (upgrade_saved_settings)
+            kwargs.update({group: regrouped[group] for group in GROUPS if given[group] is not None})
+            kwargs[SETTINGS_GIVEN_AT_LOAD] = {
+                group: regrouped[group] for group in GROUPS if given[group] is None and regrouped[group] is not None
+            }
         data = saved_data(path)
         if data is not None:
+            for name, value in SAVED_BEFORE_ATTRIBUTE.items():
+                if name not in data:
+                    kwargs.setdefault(name, value)
             holds = saved_algorithm(data)
             wanted = cls.__name__
             fits = holds == wanted or (holds == "DecQN" and wanted == "GQN")
@@ -190,12 +261,15 @@ class SavedFiles:
             raise ValueError(
                 f"{path} holds a {have} replay buffer ({type(loaded).__name__}), but this model samples "
                 f"{need} ({type(current).__name__}): load it into a model made with "
-                f"prioritized_replay={have == 'prioritized'}, or start this one with an empty buffer"
+                f"replay_buffer_kwargs=dict({PRIORITIZED}={have == 'prioritized'}), or start this one with an empty buffer"
             )
         if not isinstance(loaded, ReplayBuffer):
             raise ValueError(f"{path} holds a {type(loaded).__name__}, not a replay buffer (an SB3 ReplayBuffer)")
         if current is not None:
             check_buffer_fits(path, loaded, current)
+        if isinstance(loaded, PrioritizedSampling) and isinstance(current, PrioritizedSampling):
+            # beta follows the model's schedule (a buffer of 0.2 and earlier does not know it); alpha stays the buffer's
+            loaded.initial_beta, loaded.beta_annealing = current.initial_beta, current.beta_annealing
         self.replay_buffer = expand(loaded)
         # SB3's own steps after loading (OffPolicyAlgorithm.load_replay_buffer), on the buffer already read
         if isinstance(loaded, HerReplayBuffer):

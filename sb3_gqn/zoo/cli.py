@@ -204,9 +204,11 @@ sb3-gqn train: rl-zoo3's train with gqn and decqn registered; every rl-zoo3 opti
 Without -conf/--conf-file, gqn, decqn, sac and td3 read the project's files, sb3_gqn/zoo/hyperparams/<algo>.yml
 (the same envs, penalties and budgets for all four); an env without an entry fails with an entry printed to start
 from. GQN's and DecQN's own arguments go through -params as Python expressions, over the entry's:
-  -params bins:"(3, 9)" growth:"'linear'" growth_patience:3 decoding:"'expectation'" train_freq:2
-(bins, growth, growth_init, growth_eval_freq, growth_patience, growth_probation, exploration, acting_tau,
-decoding, decoding_temperature, prioritized_replay, n_steps, ...: help(sb3_gqn.GQN)). --n-envs N is short for
+  -params bins:"(3, 9)" growth:"'adaptive'" growth_kwargs:"dict(patience=3, eval_freq=5000)" train_freq:2
+  -params decoding:"'relative'" decoding_kwargs:"dict(temperature=0.5)" replay_buffer_kwargs:"dict(prioritized=False)"
+(bins, growth, growth_kwargs, exploration, acting_tau, decoding, decoding_kwargs, replay_buffer_kwargs, n_steps, ...:
+help(sb3_gqn.GQN); a group given replaces the entry's. 0.2's flat keywords, growth_patience:3 and the like, still work,
+with a DeprecationWarning). --n-envs N is short for
 -params n_envs:N; -optimize without --storage keeps its study in <log folder>/<algo>/optuna.db; -i <checkpoint.zip>
 continues with the checkpoint's replay buffer.
 

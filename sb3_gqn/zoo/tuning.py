@@ -1,9 +1,11 @@
 """Optuna search spaces for GQN and DecQN in rl-zoo3's sampler / converter format.
 
 rl-zoo3 calls a sampler with an Optuna trial during ``-optimize`` and a converter with a stored trial's
-raw ``params`` for ``--trial-id``; both return GQN constructor arguments, and for any trial
-``convert(trial.params) == sample(trial)``. Raw values are plain numbers and strings so that every
-Optuna storage (SQLite, PostgreSQL) can hold them.
+raw ``params`` for ``--trial-id``; both return GQN constructor arguments in 0.3's grouped spelling
+(``growth_kwargs=dict(patience=..., init=...)``), and for any trial ``convert(trial.params) == sample(trial)``. Raw
+values are plain numbers and strings so that every Optuna storage (SQLite, PostgreSQL) can hold them; their names are
+the storage's (``growth_patience``, ``growth_init``: the names of 0.2's keywords, so that a study stored by 0.2
+converts the same). Any other 0.2 keyword among them goes into its group too.
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ from __future__ import annotations
 from typing import Any
 
 import optuna
+
+from sb3_gqn.gqn.settings import DEPRECATED_KEYWORDS
 
 # Hidden layer widths per size name (DecQN uses 512x512)
 NET_ARCHS: dict[str, list[int]] = {"small": [256, 256], "medium": [512, 512], "large": [1024, 1024]}
@@ -54,7 +58,8 @@ def sample_decqn_params(
 
 
 def convert_gqn_params(params: dict[str, Any]) -> dict[str, Any]:
-    """Raw trial values -> GQN/DecQN constructor arguments (rl-zoo3 converter signature)."""
+    """Raw trial values -> GQN/DecQN constructor arguments (rl-zoo3 converter signature), the settings of one concept
+    in their group (``growth_patience`` -> ``growth_kwargs["patience"]``)."""
     hyperparams = dict(params)
     epsilon = hyperparams.pop("epsilon")
     hyperparams["exploration_initial_eps"] = epsilon
@@ -62,6 +67,9 @@ def convert_gqn_params(params: dict[str, Any]) -> dict[str, Any]:
     hyperparams["policy_kwargs"] = dict(net_arch=NET_ARCHS[hyperparams.pop("net_arch")])
     if "growth_patience" in hyperparams:  # storages hold no None: 0 means the plateau rule is off
         hyperparams["growth_patience"] = int(hyperparams["growth_patience"]) or None
+    for name in [name for name in hyperparams if name in DEPRECATED_KEYWORDS]:
+        group, key = DEPRECATED_KEYWORDS[name]
+        hyperparams[group] = {**hyperparams.get(group, {}), key: hyperparams.pop(name)}
     if isinstance(hyperparams["bins"], str):
         initial, final = hyperparams["bins"].split("-")
         hyperparams["bins"] = (int(initial), int(final))

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.callbacks import BaseCallback, ConvertCallback
+from stable_baselines3.common.type_aliases import MaybeCallback
 
 from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth, linear_growth_level
 
@@ -65,3 +66,21 @@ class GrowthCallback(BaseCallback):
             if model.growth_level >= last_level and not schedule.on_probation:
                 schedule.stop_evaluating()
         return True
+
+
+def with_growth_callback(callback: MaybeCallback, env_was_reset: bool) -> list[BaseCallback]:
+    """``learn``'s ``callback`` as a list with a :class:`GrowthCallback` in front of the user's callbacks.
+
+    :raises ValueError: for a ``callback`` that is not a ``BaseCallback``, a list of them, a callable or ``None``
+    """
+    if callback is None:
+        user_callbacks: list[BaseCallback] = []
+    elif isinstance(callback, list):
+        user_callbacks = list(callback)
+    elif isinstance(callback, BaseCallback):
+        user_callbacks = [callback]
+    elif callable(callback):
+        user_callbacks = [ConvertCallback(callback)]
+    else:
+        raise ValueError(f"callback must be a BaseCallback, a list of them, a callable or None, got {callback!r}")
+    return [GrowthCallback(env_was_reset=env_was_reset), *user_callbacks]

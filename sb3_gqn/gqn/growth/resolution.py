@@ -28,6 +28,7 @@ class GrowingResolution:
     (``policy``) over the nested levels ``bin_levels``."""
 
     bin_levels: list[int]
+    growth: str | None
     growth_level: int
     growth_init: str
     growth_events: list[tuple[int, int]]
@@ -42,6 +43,20 @@ class GrowingResolution:
     verbose: int
     _active_bin_indices: np.ndarray
     _learning_bins_mask: th.Tensor
+
+    def _start_growth(self, growth: str | None, growth_init: str, schedule: AdaptiveGrowth | None) -> None:
+        """Set the growth state of a new model at the first level (``schedule`` kept for ``growth="adaptive"``)."""
+        self.growth = growth
+        self.growth_init = growth_init
+        self.growth_level = 0
+        #: ``(env step, active bins)`` of every growth so far: when each level opened for learning and exploration
+        #: (saved with the model; plots mark them)
+        self.growth_events = []
+        #: ``(env step, deployed bins)`` of every change of the level ``predict`` acts on (with the ``probation`` of
+        #: ``growth_kwargs`` after an opened level's probation; otherwise the same as ``growth_events``)
+        self.deployments = []
+        self._deployed_level = None
+        self.growth_schedule = schedule if growth == "adaptive" else None
 
     @property
     def active_bins(self) -> int:

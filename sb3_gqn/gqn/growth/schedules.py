@@ -9,11 +9,13 @@
   the current return falls below the threshold of paper eq. 4 (:func:`adaptive_threshold`), or when
   the returns have stopped improving (:func:`plateau`, which eq. 4 cannot see: a flat return has
   ``sigma = 0`` and never falls below ``0.95 mu``).
-* ``growth_init="interpolate"``: :func:`interpolation_neighbours` says which two active bins each
+* ``growth_kwargs=dict(init="interpolate")``: :func:`interpolation_neighbours` says which two active bins each
   newly opened bin is warm-started from.
-* ``growth_probation`` (adaptive growth): a level the schedule opens is explored at once, but the agent keeps
-  acting greedily and bootstrapping on the deployed level until a greedy episode over the new one holds the return
-  (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
+* ``growth_kwargs=dict(probation=k)`` (adaptive growth): a level the schedule opens is explored at once, but the agent
+  keeps acting greedily and bootstrapping on the deployed level until a greedy episode over the new one holds the
+  return (:func:`probation_holds`); see :class:`AdaptiveGrowth`.
+
+:func:`growth_settings` turns GQN's ``growth`` and ``growth_kwargs`` into the warm start and the schedule's state.
 
 :class:`~sb3_gqn.gqn.growth.callback.GrowthCallback` drives either schedule during ``learn()``.
 """
@@ -21,7 +23,8 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import MISSING, dataclass, field, fields
+from typing import Any, ClassVar
 
 import numpy as np
 from gymnasium import spaces
@@ -29,7 +32,10 @@ from gymnasium import spaces
 from sb3_gqn.common.arguments import check_choice, check_int, check_number
 
 GROWTH_SCHEDULES = ("adaptive", "linear", None)
+#: How a newly opened bin's head row starts: the mean of its two nested neighbours' (``"interpolate"``, the default)
+#: or as it is (``"none"``, the paper); ``growth_kwargs["init"]``, for every schedule and for ``grow()`` by hand
 GROWTH_INITS = ("interpolate", "none")
+DEFAULT_GROWTH_INIT = "interpolate"
 RETURN_SOURCES = ("evaluation", "training")
 
 
@@ -237,15 +243,36 @@ class AdaptiveGrowth:
     read the evaluation returns as without probation. With ``returns_source="training"`` no episode acts greedily
     over the opened level, so the first training return that holds deploys it (usually the next one).
 
-    :param eval_freq: environment steps between evaluations
+    GQN builds it from ``growth_kwargs`` (:func:`growth_settings`): its settings are the first seven fields
+    (:attr:`SETTINGS`), the others the state that ``learn()`` moves on and ``save`` keeps.
+
+    :param eval_freq: environment steps between greedy evaluations, which are interleaved in training (their
+        transitions are stored and count as steps)
     :param eval_episodes: greedy episodes averaged into one evaluation return
-    :param window: number of past returns in the moving mean and standard deviation
-    :param returns_source: ``"evaluation"`` or ``"training"``
-    :param patience: returns without improvement before the plateau rule grows (``None``: off)
-    :param min_improvement: relative gain that counts as an improvement for the plateau rule
-    :param probation: evaluations over an opened level before it is deployed even if none held (``None``: deploy
-        at opening, the paper as written)
+    :param window: number of past returns in eq. 4's moving mean and standard deviation
+    :param returns_source: ``"evaluation"`` (greedy episodes) or ``"training"`` (every finished training episode)
+    :param patience: returns in a row without a ``min_improvement`` gain before the plateau rule grows (it sees the
+        flat plateaus eq. 4 cannot); ``None``: eq. 4 alone
+    :param min_improvement: relative gain over the level's best return that counts as an improvement for the plateau
+        rule
+    :param probation: ``None`` deploys a level when it opens (the paper as written); an int ``k`` keeps greedy actions
+        and the TD target's max on the deployed level until a greedy episode over the opened one holds 70 % of its
+        return, at most ``k`` tries
     """
+
+    #: The schedule's settings (``growth_kwargs`` keys besides ``init``); the other fields are its state
+    SETTINGS: ClassVar[tuple[str, ...]] = (
+        "eval_freq",
+        "eval_episodes",
+        "window",
+        "returns_source",
+        "patience",
+        "min_improvement",
+        "probation",
+    )
+    #: What a schedule saved before a field existed ran with, where it is not the field's default: models saved
+    #: before the plateau rule ran eq. 4 alone (fields missing from this table take their defaults)
+    BEFORE_FIELD: ClassVar[dict[str, Any]] = {"patience": None}
 
     eval_freq: int = 2_500
     eval_episodes: int = 1
@@ -265,29 +292,40 @@ class AdaptiveGrowth:
     episode_returns: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self) -> None:
-        # The constructor's own checks (sb3_gqn.common.arguments), under the names GQN's arguments carry
-        check_choice("growth_returns", self.returns_source, RETURN_SOURCES)
-        self.eval_freq = check_int("growth_eval_freq", self.eval_freq, 1)
-        self.eval_episodes = check_int("growth_eval_episodes", self.eval_episodes, 1)
-        self.window = check_int("growth_window", self.window, 1)
+        # The constructor's own checks (sb3_gqn.common.arguments), under the names GQN's growth_kwargs carry
+        check_choice("growth_kwargs['returns_source']", self.returns_source, RETURN_SOURCES)
+        self.eval_freq = check_int("growth_kwargs['eval_freq']", self.eval_freq, 1)
+        self.eval_episodes = check_int("growth_kwargs['eval_episodes']", self.eval_episodes, 1)
+        self.window = check_int("growth_kwargs['window']", self.window, 1)
         if self.patience is not None:
-            self.patience = check_int("growth_patience", self.patience, 1)
-        self.min_improvement = check_number("growth_min_improvement", self.min_improvement, 0.0)
+            self.patience = check_int("growth_kwargs['patience']", self.patience, 1)
+        self.min_improvement = check_number("growth_kwargs['min_improvement']", self.min_improvement, 0.0)
         if self.probation is not None:
-            self.probation = check_int("growth_probation", self.probation, 1)
+            self.probation = check_int("growth_kwargs['probation']", self.probation, 1)
         if self.next_eval_step == 0:
             self.next_eval_step = self.eval_freq
 
-    def __setstate__(self, state: dict) -> None:
-        # Models saved before the plateau rule existed: eq. 4 alone, the level's returns start from the window
-        state.setdefault("patience", None)
-        state.setdefault("min_improvement", 0.05)
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # Schedules saved before a field existed (0.1.0 had no plateau rule and no probation): what they ran with
+        # (BEFORE_FIELD), else the field's default; the level's returns start from the window
         state.setdefault("level_returns", list(state.get("history", [])))
-        # Models saved before probation existed: deployed at opening, as they were trained
-        state.setdefault("probation", None)
-        state.setdefault("probation_reference", None)
-        state.setdefault("probation_tries", 0)
+        for item in fields(self):
+            if item.name not in state:
+                default = item.default_factory() if item.default is MISSING else item.default  # type: ignore[misc]
+                state[item.name] = self.BEFORE_FIELD.get(item.name, default)
         self.__dict__.update(state)
+
+    def settings(self) -> dict[str, Any]:
+        """The schedule's settings (:attr:`SETTINGS`) by name, as ``growth_kwargs`` writes them."""
+        return {name: getattr(self, name) for name in self.SETTINGS}
+
+    def change_settings(self, **settings: Any) -> None:
+        """Change settings (``load(path, growth_kwargs=...)``), checked as the constructor checks them; the state goes
+        on. ``ValueError`` naming a key that is not a setting."""
+        check_growth_keys(settings, self.SETTINGS)
+        checked = AdaptiveGrowth(**{**self.settings(), **settings})
+        for name in self.SETTINGS:
+            setattr(self, name, getattr(checked, name))
 
     @property
     def on_probation(self) -> bool:
@@ -388,3 +426,28 @@ class AdaptiveGrowth:
         self.pending_episodes = 0
         self.finished_eval_returns = []
         self.greedy_envs[:] = False
+
+
+def check_growth_keys(growth_kwargs: dict[str, Any], valid: tuple[str, ...]) -> None:
+    """``ValueError`` naming the keys of ``growth_kwargs`` that are not in ``valid``."""
+    unknown = sorted(str(key) for key in growth_kwargs if key not in valid)
+    if unknown:
+        raise ValueError(f"growth_kwargs has no setting {', '.join(map(repr, unknown))}: its keys are {valid}")
+
+
+def growth_settings(growth: str | None, growth_kwargs: dict[str, Any] | None) -> tuple[str, AdaptiveGrowth | None]:
+    """GQN's ``growth`` and ``growth_kwargs`` checked: the warm start of opened bins (``growth_kwargs["init"]``,
+    :data:`DEFAULT_GROWTH_INIT` when not given) and, for ``growth="adaptive"``, the schedule built from the other keys
+    (:class:`AdaptiveGrowth`'s settings, checked whichever schedule runs; its defaults where not given).
+
+    :raises ValueError: naming ``growth`` or the ``growth_kwargs`` key that is wrong
+    """
+    check_choice("growth", growth, GROWTH_SCHEDULES)
+    if growth_kwargs is not None and not isinstance(growth_kwargs, dict):
+        raise ValueError(f"growth_kwargs must be a dict (or None), got {growth_kwargs!r}")
+    settings = dict(growth_kwargs or {})
+    check_growth_keys(settings, ("init", *AdaptiveGrowth.SETTINGS))
+    init = settings.pop("init", DEFAULT_GROWTH_INIT)
+    check_choice("growth_kwargs['init']", init, GROWTH_INITS)
+    schedule = AdaptiveGrowth(**settings)
+    return init, schedule if growth == "adaptive" else None
