@@ -53,9 +53,10 @@ def kill_after_first_checkpoint(out: Path) -> None:
     assert not (out / "runs" / SPEC.name / "done.json").exists()
 
 
-def curve_steps(out: Path, spec: RunSpec = SPEC) -> list[int]:
+def curve_steps(out: Path, spec: RunSpec = SPEC, decoding: str = "") -> list[int]:
+    """The steps of a run's evaluations read with its own decoding (``""``) or with a paired one."""
     with open(out / "runs" / spec.name / "curve.csv", newline="") as handle:
-        return [int(row["step"]) for row in csv.DictReader(handle)]
+        return [int(row["step"]) for row in csv.DictReader(handle) if row["decoding"] == decoding]
 
 
 def kill_after_two_checkpoints(out: Path) -> tuple[int, int]:
@@ -96,6 +97,7 @@ def test_a_killed_run_resumes_from_its_checkpoint_and_follows_the_uninterrupted_
     assert json.loads((uninterrupted / "runs" / SPEC.name / "done.json").read_text())["resumed_from"] == []
     # every evaluation once, up to the budget; the final model at the budget
     assert curve_steps(tmp_path) == list(range(EVAL_FREQ, STEPS + 1, EVAL_FREQ)) == curve_steps(uninterrupted)
+    assert curve_steps(tmp_path, decoding="relative") == curve_steps(tmp_path)  # each paired reading once too
     resumed = GQN.load(tmp_path / "runs" / SPEC.name / "model.zip")
     assert resumed.num_timesteps == STEPS
     # resumed at an episode end on one torch thread: the same parameters and evaluations as without the kill
@@ -150,8 +152,7 @@ def test_a_run_without_a_whole_checkpoint_starts_again_with_a_warning(tmp_path):
     with pytest.warns(UserWarning, match="starting again from scratch"):
         run(spec, tmp_path, 200, 1, 1, checkpoint_freq=FREQ)
     assert json.loads((run_dir / "done.json").read_text())["resumed_from"] == []
-    with open(run_dir / "curve.csv", newline="") as handle:
-        assert [int(row["step"]) for row in csv.DictReader(handle)] == [200, 400]
+    assert curve_steps(tmp_path, spec) == [200, 400]
 
 
 def test_checkpoint_frequency_must_be_positive():

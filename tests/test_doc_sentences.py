@@ -146,7 +146,7 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         ),
         "bins=(3, 9) needs 9 choices per action dimension, but the env's action space Discrete(2) has 2: pass bins=2 "
         "(or a pair ending in it)": lambda: GQN("MlpPolicy", "CartPole-v1", bins=(3, 9)),
-        "decoding_temperature must be a number in [1.175e-38, 3.403e+38], float32's positive normal range (the "
+        "decoding_temperature must be None or a number in [1.175e-38, 3.403e+38], float32's positive normal range (the "
         "utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN)": lambda: GQN(
             "MlpPolicy", DecliningEnv(), decoding_temperature=1e300
         ),

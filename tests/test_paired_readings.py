@@ -71,7 +71,7 @@ def test_a_curve_an_earlier_release_began_continues_under_todays_header(tmp_path
     curve = tmp_path / "curve.csv"
     earlier = [column for column in COLUMNS if column != "decoding"]
     curve.write_text(",".join(earlier) + "\n" + ",".join("1" for _ in earlier) + "\n")
-    append_row(curve, {column: "2" for column in COLUMNS})
+    append_row(curve, dict.fromkeys(COLUMNS, "2"))
     with open(curve, newline="") as handle:
         reader = csv.DictReader(handle)
         rows = list(reader)
