@@ -35,12 +35,17 @@ PLAIN_TORSO = "dict(layer_norm=False, activation_fn=nn.ReLU)"
 #: the paper's growth as written, the ablation's starting point
 PAPER_AS_WRITTEN = {
     "growth": "adaptive",
-    "growth_init": "none",
-    "growth_patience": None,
-    "growth_eval_freq": 5_000,
+    "growth_kwargs": {"init": "none", "patience": None, "eval_freq": 5_000},
     "exploration": "per_dimension",
     "acting_tau": None,
 }
+
+
+def flat_settings(hyperparams: dict) -> dict:
+    """``hyperparams`` with ``growth_kwargs``'s keys beside the others (``growth_kwargs.init``)."""
+    growth_kwargs = hyperparams.get("growth_kwargs") or {}
+    flat = {key: value for key, value in hyperparams.items() if key != "growth_kwargs"}
+    return {**flat, **{f"growth_kwargs.{key}": value for key, value in growth_kwargs.items()}}
 
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
@@ -185,12 +190,13 @@ def test_invocations_collecting_into_one_table_at_once_keep_each_others_runs(tmp
 def test_ablation_variants_differ_from_the_paper_as_written_in_one_change_each(research_variants):
     assert research_variants["gqn-before"].hyperparams == PAPER_AS_WRITTEN
     for name in ["gqn-before+warm-start", "gqn-before+plateau", "gqn-before+shared"]:
-        changed = {key for key, value in research_variants[name].hyperparams.items() if PAPER_AS_WRITTEN.get(key) != value}
+        paper = flat_settings(PAPER_AS_WRITTEN)
+        changed = {key for key, value in flat_settings(research_variants[name].hyperparams).items() if paper.get(key) != value}
         assert (
             changed
             == {
-                "gqn-before+warm-start": {"growth_init"},
-                "gqn-before+plateau": {"growth_patience", "growth_eval_freq"},
+                "gqn-before+warm-start": {"growth_kwargs.init"},
+                "gqn-before+plateau": {"growth_kwargs.patience", "growth_kwargs.eval_freq"},
                 "gqn-before+shared": {"exploration"},
             }[name]
         )
@@ -461,6 +467,18 @@ def test_warm_started_is_every_variant_but_the_cold_ablation(research_variants):
     assert warm("gqn-adaptive+residual+1update")
     assert warm("a-table-from-elsewhere")  # the class default
     assert warm_started("gqn-before")  # an agent of a variants file is known only where its agents are passed
+
+
+def test_warm_started_reads_a_variants_file_in_either_spelling(tmp_path):
+    from sb3_gqn.experiments.variants import load_variants
+
+    (tmp_path / "variants.yml").write_text(
+        "cold-0-2:\n  algo: gqn\n  hyperparams: {growth_init: none}\n"
+        "cold:\n  algo: gqn\n  hyperparams: {growth_kwargs: {init: none}}\n"
+        "warm:\n  algo: gqn\n  hyperparams: {growth_kwargs: {patience: 2}}\n"
+    )
+    variants = load_variants(tmp_path / "variants.yml")
+    assert [warm_started(algo, variants) for algo in ("cold-0-2", "cold", "warm")] == [False, False, True]
 
 
 def test_loading_a_variants_file_changes_nothing_global(tmp_path):

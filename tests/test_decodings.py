@@ -82,4 +82,4 @@ def test_the_command_prints_each_models_rows_and_their_means(tmp_path, capsys):
     ]
     written = pd.read_csv(tmp_path / "rows.csv")
     assert list(written["decoding"]) == ["greedy", "hysteresis 0.5", "softmax 0.2"]
-    assert list(written.columns) == ["model", "decoding", "return", "task_return", "smoothness", "action_change"]
+    assert list(written.columns) == ["model", "decoding", "return", "task_return", "smoothness", "action_change", "success"]

@@ -12,15 +12,10 @@ import torch as th
 from sb3_gqn import GQN
 from sb3_gqn.common.masking import DEFAULT_DECODING_TEMPERATURES, masked_expectation
 from sb3_gqn.export import export_onnx, export_torchscript
+from tests.test_expectation_decoding import pendulum_model
 from tests.test_export import observations, run_onnx, run_torchscript
 
 onnxruntime = pytest.importorskip("onnxruntime")
-
-
-def pendulum_model(**kwargs) -> GQN:
-    model = GQN("MlpPolicy", "Pendulum-v1", bins=(2, 9), growth=None, policy_kwargs=dict(net_arch=[16]), seed=0, **kwargs)
-    model.grow(2)  # 5 of 9 bins active: the mask matters
-    return model
 
 
 def test_the_temperature_is_relative_to_the_spread_of_the_active_utilities():

@@ -126,7 +126,8 @@ print(hasattr(buffers, "PrioritizedReplayBuffer"), buffers.__spec__.name, sys.mo
     assert run_python(code) == "True sb3_gqn.common.buffers True"
 
 
-def test_loading_files_saved_by_0_1_0_inside_quiet_old_paths_does_not_warn():
+@pytest.mark.parametrize("block", ["with quiet_old_paths():", "if True:  # load quiets the old paths itself"])
+def test_loading_files_saved_by_0_1_0_does_not_warn(block):
     code = f"""
 import sys, warnings
 import gymnasium as gym
@@ -137,7 +138,7 @@ sys.path.insert(0, fixtures)
 from make_fixtures import DictPendulum
 with warnings.catch_warnings():
     warnings.simplefilter("error")
-    with quiet_old_paths():
+    {block}
         for algo, name, env in [
             (GQN, "gqn_linear_pendulum", gym.make("Pendulum-v1")),
             (GQN, "gqn_adaptive_dict_pendulum", DictPendulum(gym.make("Pendulum-v1"))),

@@ -165,7 +165,7 @@ def test_grouped_settings_save_load_and_continue(tmp_path):
 def test_load_takes_the_groups_and_the_0_2_keywords(tmp_path):
     GQN("MlpPolicy", "Pendulum-v1", replay_buffer_kwargs=dict(alpha=0.5), **TINY).save(tmp_path / "model")
     loaded = GQN.load(tmp_path / "model", growth_kwargs=dict(patience=4, init="none"), decoding="relative")
-    assert (loaded.growth_schedule.patience, loaded.growth_init, loaded.softmax_temperature) == (4, "none", 0.3)
+    assert (loaded.growth_schedule.patience, loaded.growth_init, loaded.softmax_temperature) == (4, "none", 0.1)
     with pytest.warns(DeprecationWarning, match=r"GQN\.load: decoding_temperature=0\.6"):
         loaded = GQN.load(tmp_path / "model", decoding="relative", decoding_temperature=0.6, growth_window=5)
     assert (loaded.softmax_temperature, loaded.growth_schedule.window) == (0.6, 5)

@@ -103,8 +103,10 @@ def append_row(path: Path, row: dict[str, Any]) -> None:
     earlier release began, with fewer columns, is rewritten under today's header first)."""
     if path.is_file() and path.stat().st_size:
         with open(path, newline="") as handle:
-            earlier = list(csv.DictReader(handle))
-        if earlier and list(earlier[0]) != COLUMNS:
+            header = next(csv.reader(handle), [])
+        if header != COLUMNS:  # only a file begun by an earlier release is read whole
+            with open(path, newline="") as handle:
+                earlier = list(csv.DictReader(handle))
             with open(path, "w", newline="") as handle:
                 writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
                 writer.writeheader()

@@ -109,11 +109,15 @@ def with_variants_files(paths: Iterable[str | Path] = ()) -> dict[str, Variant]:
 
 
 def warm_started(algo: str, variants: Mapping[str, Variant] = VARIANTS) -> bool:
-    """Whether agent ``algo`` of ``variants`` opens bins with a warm start (``growth_init="interpolate"``, the class
-    default and every shipped entry's). Names ``variants`` does not hold (tables written elsewhere) count as
-    warm-started."""
+    """Whether agent ``algo`` of ``variants`` opens bins with a warm start (``growth_kwargs=dict(init="interpolate")``,
+    the class default and every shipped entry's; a variants file of 0.2 may still spell it ``growth_init``). Names
+    ``variants`` does not hold (tables written elsewhere) count as warm-started."""
     variant = variants.get(algo)
-    return variant is None or variant.hyperparams.get("growth_init", "interpolate") == "interpolate"
+    if variant is None:
+        return True
+    growth_kwargs = variant.hyperparams.get("growth_kwargs") or {}
+    init = growth_kwargs.get("init", variant.hyperparams.get("growth_init", "interpolate"))
+    return init == "interpolate"
 
 
 SHORT_SUITE = dict(

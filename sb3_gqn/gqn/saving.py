@@ -19,6 +19,7 @@ from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
 from sb3_gqn.common.buffers import PRIORITIZED, PrioritizedSampling
 from sb3_gqn.common.compact_buffer import compact, expand
+from sb3_gqn.common.module_aliases import quiet_old_paths
 from sb3_gqn.gqn.growth.schedules import (
     AdaptiveGrowth,
     bin_levels_from,
@@ -211,7 +212,8 @@ class SavedFiles:
         ``DecQN.load``; a GQN file with static bins loads into either). Keyword arguments set the model's settings as
         in SB3; ``growth_kwargs`` change the warm start and the adaptive schedule's settings, whose state goes on, and
         the 0.2 keywords (``growth_patience=3``, ...) still work, with a ``DeprecationWarning``
-        (:func:`upgrade_saved_settings`)."""
+        (:func:`upgrade_saved_settings`). Files of 0.1.0, which name their classes by the old module paths, load
+        without a warning (:func:`~sb3_gqn.common.module_aliases.quiet_old_paths`)."""
         check_model_file(path)
         deprecated = {key: kwargs.pop(key) for key in list(kwargs) if key in DEPRECATED_KEYWORDS}
         if deprecated:
@@ -237,7 +239,8 @@ class SavedFiles:
                 raise ValueError(f"{path} holds a {holds} model{extra}, not a {wanted} model: load it with {holds}.load")
             if kwargs.get("bins") is not None and data.get("bins") is not None:
                 kwargs.update(levels_for_new_bins(path, data, kwargs["bins"]))
-        return super().load(path, *args, **kwargs)  # type: ignore[misc]
+        with quiet_old_paths():  # a file of 0.1.0 names its classes by the old module paths, which its reader cannot change
+            return super().load(path, *args, **kwargs)  # type: ignore[misc]
 
     def save_replay_buffer(self, path: SavedPath) -> None:
         """Save the replay buffer (with its priorities) as a pickle of the filled rows only: a buffer of 1M rows
@@ -251,7 +254,8 @@ class SavedFiles:
         whose sampling (prioritized or uniform) is not the model's: the model would silently change how it learns."""
         current = self.replay_buffer
         try:
-            loaded = load_from_pkl(path, self.verbose)
+            with quiet_old_paths():
+                loaded = load_from_pkl(path, self.verbose)
         except (pickle.UnpicklingError, EOFError, AttributeError, ImportError, IndexError, ValueError) as error:
             raise ValueError(f"{path} is not a replay-buffer file ({type(error).__name__}: {error})") from None
         kinds_differ = isinstance(current, PrioritizedSampling) != isinstance(loaded, PrioritizedSampling)
