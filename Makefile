@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
 
-.PHONY: venv venv-myo results test test-slow test-myo lint docs benchmark results-page constraints constraints-myo clean
+.PHONY: venv venv-myo results test test-slow test-myo lint typecheck docs benchmark results-page constraints constraints-myo clean
 
 $(VENV)/.installed: setup.cfg pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -32,7 +32,11 @@ lint: venv
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-test: venv lint
+# mypy over the package (configured in pyproject.toml)
+typecheck: venv
+	$(BIN)/mypy
+
+test: venv lint typecheck
 	$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS)
 
 test-slow: venv

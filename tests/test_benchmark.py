@@ -47,6 +47,7 @@ def flat_settings(hyperparams: dict) -> dict:
     flat = {key: value for key, value in hyperparams.items() if key != "growth_kwargs"}
     return {**flat, **{f"growth_kwargs.{key}": value for key, value in growth_kwargs.items()}}
 
+
 TINY = ["--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "400", "--eval-freq", "200"]
 TINY += ["--eval-episodes", "1", "--jobs", "2"]
 

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import copy
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import torch as th
@@ -71,10 +71,16 @@ class PrioritizedSampling:
     """
 
     #: the n-step buffer class whose ``_get_samples`` computes the samples (set by the concrete classes)
-    n_step_buffer: type
+    n_step_buffer: type[NStepReplayBuffer] | type[NStepDictReplayBuffer]
     buffer_size: int
     n_envs: int
     pos: int
+
+    if TYPE_CHECKING:  # the n-step buffer's, which every concrete class also derives from
+
+        def size(self) -> int: ...
+
+        def to_torch(self, array: np.ndarray, copy: bool = True) -> th.Tensor: ...
 
     def __init__(
         self,
@@ -102,7 +108,7 @@ class PrioritizedSampling:
         check_int("n_steps", n_steps, 1)
         check_number("gamma", gamma, 0.0, 1.0, low_open=True)
         check_priority_settings(dict(alpha=alpha, beta=beta, epsilon=epsilon, beta_annealing=beta_annealing), "")
-        super().__init__(  # type: ignore[call-arg]
+        super().__init__(  # type: ignore[call-arg]  # a mixin: the n-step buffer's constructor is next in the bases
             buffer_size,
             observation_space,
             action_space,
@@ -160,11 +166,11 @@ class PrioritizedSampling:
     ) -> None:
         """Store one transition per env (SB3's ``add``) with the maximum priority seen so far."""
         row = self.pos
-        super().add(obs, next_obs, action, reward, done, infos)  # type: ignore[misc]
+        super().add(obs, next_obs, action, reward, done, infos)  # type: ignore[misc]  # a mixin, as in __init__
         first = row * self.n_envs
         self.priorities.update_unchecked(np.arange(first, first + self.n_envs), np.full(self.n_envs, self.max_priority))
 
-    def sample(self, batch_size: int, env: VecNormalize | None = None) -> PrioritizedReplayBufferSamples:  # type: ignore[override]
+    def sample(self, batch_size: int, env: VecNormalize | None = None) -> PrioritizedReplayBufferSamples:
         """
         Sample ``batch_size`` transitions in proportion to their priorities.
 
@@ -178,23 +184,23 @@ class PrioritizedSampling:
             indices = indices[np.argsort(indices % self.n_envs, kind="stable")]
         rows, env_columns = np.divmod(indices, self.n_envs)
 
+        # SB3's n-step sampling, called on this buffer (self is also an instance of n_step_buffer)
+        get_samples: Any = self.n_step_buffer._get_samples
         if self.n_envs == 1:
-            samples = self.n_step_buffer._get_samples(self, rows, env=env)
+            samples = get_samples(self, rows, env=env)
         else:
             parts = [
-                self.n_step_buffer._get_samples(self._env_column(int(column)), rows[env_columns == column], env=env)
+                get_samples(self._env_column(int(column)), rows[env_columns == column], env=env)
                 for column in np.unique(env_columns)
             ]
             samples = type(parts[0])(*(_concatenate(fields) for fields in zip(*parts)))
 
         # P(i) = p_i / sum_k p_k over the N stored transitions; w_i = (N * P(i)) ** -beta / max_j w_j
         probabilities = self.priorities.nodes[indices + self.priorities.capacity] / self.priorities.total
-        weights = (self.size() * self.n_envs * probabilities) ** -self.beta  # type: ignore[attr-defined]
+        weights = (self.size() * self.n_envs * probabilities) ** -self.beta
         weights /= weights.max()
         return PrioritizedReplayBufferSamples(
-            *samples,
-            weights=self.to_torch(weights.astype(np.float32).reshape(-1, 1)),  # type: ignore[attr-defined]
-            indices=indices,
+            **samples._asdict(), weights=self.to_torch(weights.astype(np.float32).reshape(-1, 1)), indices=indices
         )
 
     def _env_column(self, column: int) -> PrioritizedSampling:
@@ -230,7 +236,7 @@ class PrioritizedSampling:
         if td_errors.shape != indices.shape:
             raise ValueError(f"Got {indices.size} indices but {td_errors.size} TD errors")
         td_errors = check_priorities(td_errors, what="TD errors (absolute values |td|)")
-        stored = self.size() * self.n_envs  # type: ignore[attr-defined]
+        stored = self.size() * self.n_envs
         if not np.issubdtype(indices.dtype, np.integer):
             raise TypeError(f"Transition indices must be integers, got dtype {indices.dtype}")
         if indices.size and (indices.min() < 0 or indices.max() >= stored):
@@ -248,7 +254,8 @@ def _concatenate(fields: tuple[Any, ...]) -> Any:
     return None if fields[0] is None else th.cat(fields)
 
 
-class PrioritizedReplayBuffer(PrioritizedSampling, NStepReplayBuffer):
+# sample returns SB3's fields plus weights and indices: a NamedTuple of its own (a NamedTuple cannot extend SB3's)
+class PrioritizedReplayBuffer(PrioritizedSampling, NStepReplayBuffer):  # type: ignore[misc]
     """Prioritized n-step replay for array observations on SB3's ``NStepReplayBuffer`` (see :class:`PrioritizedSampling`)."""
 
     n_step_buffer = NStepReplayBuffer
@@ -261,7 +268,7 @@ class PrioritizedReplayBuffer(PrioritizedSampling, NStepReplayBuffer):
             )
 
 
-class PrioritizedDictReplayBuffer(PrioritizedSampling, NStepDictReplayBuffer):
+class PrioritizedDictReplayBuffer(PrioritizedSampling, NStepDictReplayBuffer):  # type: ignore[misc]  # as above
     """Prioritized n-step replay for ``Dict`` observations on :class:`~sb3_gqn.common.nstep_dict.NStepDictReplayBuffer`
     (see :class:`PrioritizedSampling`)."""
 

@@ -21,6 +21,9 @@ ROW_ARRAYS = ("observations", "next_observations", "actions", "rewards", "dones"
 #: set on a compacted copy: the full ``buffer_size`` its arrays were cut from
 COMPACT_MARKER = "_compacted_from_rows"
 
+#: a prioritized buffer's attribute that holds its priorities (a sum tree; the written rows' leaves when compact)
+PRIORITIES = "priorities"
+
 
 def _map_arrays(value: Any, function: Any) -> Any:
     if isinstance(value, dict):  # Dict observations: one array per key
@@ -38,9 +41,9 @@ def compact(buffer: ReplayBuffer) -> ReplayBuffer:
     for name in ROW_ARRAYS:
         if hasattr(buffer, name):
             setattr(compacted, name, _map_arrays(getattr(buffer, name), lambda array: array[:rows].copy()))
-    priorities = getattr(buffer, "priorities", None)
+    priorities = getattr(buffer, PRIORITIES, None)
     if isinstance(priorities, SumTree):
-        compacted.priorities = priorities.leaves[: rows * buffer.n_envs].copy()  # type: ignore[attr-defined]
+        setattr(compacted, PRIORITIES, priorities.leaves[: rows * buffer.n_envs].copy())
     setattr(compacted, COMPACT_MARKER, buffer.buffer_size)
     return compacted
 
@@ -60,11 +63,11 @@ def expand(buffer: ReplayBuffer) -> ReplayBuffer:
     for name in ROW_ARRAYS:
         if hasattr(buffer, name):
             setattr(buffer, name, _map_arrays(getattr(buffer, name), allocate))
-    priorities = getattr(buffer, "priorities", None)
+    priorities = getattr(buffer, PRIORITIES, None)
     if isinstance(priorities, np.ndarray):
         tree = SumTree(buffer_size * buffer.n_envs)
         if priorities.size:
             tree.update(np.arange(priorities.size), priorities)
-        buffer.priorities = tree  # type: ignore[attr-defined]
+        setattr(buffer, PRIORITIES, tree)
     delattr(buffer, COMPACT_MARKER)
     return buffer

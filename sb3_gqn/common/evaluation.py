@@ -59,7 +59,6 @@ def rollout_episodes(
 
     :param seed: seed of the first episode's reset (episode k uses ``seed + k``); ``None``: no reseeding
     """
-    box = isinstance(env.action_space, spaces.Box)
     episodes = []
     for episode in range(n_episodes):
         observation, _ = env.reset(seed=None if seed is None else seed + episode)
@@ -73,7 +72,7 @@ def rollout_episodes(
             penalty += float(info.get("action_penalty", 0.0))
             done = terminated or truncated
         taken = np.stack(actions)
-        scaled = normalized_actions(taken, env.action_space) if box else taken
+        scaled = normalized_actions(taken, env.action_space) if isinstance(env.action_space, spaces.Box) else taken
         episodes.append(Episode(scaled, task_return, total_return, penalty, final_success(info)))
     return episodes
 
@@ -147,7 +146,10 @@ def rollout_figures(
     means = np.mean([[getattr(figure, name) for name in _MEAN_FIELDS] for figure in figures], axis=0)
     flags = [figure.success for figure in figures if not math.isnan(figure.success)]
     success = float(np.mean(flags)) if flags else math.nan
-    return SmoothnessFigures(*map(float, means), freq=float(freq), episodes=n_episodes, success=success)
+    task_return, penalty, magnitude, change, smoothness, return_, length = (float(mean) for mean in means)  # _MEAN_FIELDS
+    return SmoothnessFigures(
+        task_return, penalty, magnitude, change, smoothness, return_, length, float(freq), n_episodes, success
+    )
 
 
 def growth_columns(model: Any) -> dict[str, Any]:

@@ -74,6 +74,7 @@ class NStepDictReplayBuffer(DictReplayBuffer):
         self.n_steps = check_int("n_steps", n_steps, 1)
         self.gamma = check_number("gamma", gamma, 0.0, 1.0, low_open=True)
 
+    # returns Dict samples, not the base class's ReplayBufferSamples (SB3's DictReplayBuffer overrides it alike)
     def _get_samples(  # type: ignore[override]
         self, batch_inds: np.ndarray, env: VecNormalize | None = None
     ) -> DictReplayBufferSamples:
@@ -83,10 +84,11 @@ class NStepDictReplayBuffer(DictReplayBuffer):
         next_observations = self._normalize_obs(
             {key: obs[last_indices, env_indices] for key, obs in self.next_observations.items()}, env
         )
+        assert isinstance(observations, dict) and isinstance(next_observations, dict)  # _normalize_obs keeps the dict
         return DictReplayBufferSamples(
-            observations={key: self.to_torch(obs) for key, obs in observations.items()},  # type: ignore[union-attr]
+            observations={key: self.to_torch(obs) for key, obs in observations.items()},
             actions=self.to_torch(self.actions[batch_inds, env_indices]),
-            next_observations={key: self.to_torch(obs) for key, obs in next_observations.items()},  # type: ignore[union-attr]
+            next_observations={key: self.to_torch(obs) for key, obs in next_observations.items()},
             dones=self.to_torch(final_dones),
             rewards=self.to_torch(returns),
             discounts=self.to_torch(discounts),

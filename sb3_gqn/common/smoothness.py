@@ -96,8 +96,9 @@ def control_frequency(env: gym.Env) -> float | None:
     """
     unwrapped = env.unwrapped
     timestep = getattr(unwrapped, "dt", None)
-    if timestep is None and hasattr(getattr(unwrapped, "_env", None), "control_timestep"):
-        timestep = unwrapped._env.control_timestep()  # shimmy's DmControlCompatibilityV0
+    wrapped = getattr(unwrapped, "_env", None)  # shimmy's DmControlCompatibilityV0 keeps the dm_control env there
+    if timestep is None and wrapped is not None and hasattr(wrapped, "control_timestep"):
+        timestep = wrapped.control_timestep()
     try:
         return 1.0 / float(timestep) if timestep else None
     except (TypeError, ValueError):

@@ -126,7 +126,7 @@ def clip_grad_norm(parameters: Iterable[th.nn.Parameter], max_norm: float) -> th
     ~0.1 ms of a ~4.5 ms cartpole update. Elsewhere (CUDA) this is ``clip_grad_norm_``. Returns the total norm.
     """
     with_grad = [parameter for parameter in parameters if parameter.grad is not None]
-    total_norm = th.nn.utils.get_total_norm([parameter.grad for parameter in with_grad])
+    total_norm = th.nn.utils.get_total_norm([parameter.grad for parameter in with_grad if parameter.grad is not None])
     if total_norm.device.type != "cpu" or not total_norm + 1e-6 <= max_norm:  # NaN norms go on to PyTorch too
         th.nn.utils.clip_grads_with_norm_(with_grad, max_norm, total_norm)
     return total_norm

@@ -100,7 +100,7 @@ class DecoupledMLP(nn.Module):
             output = hidden
             # Each layer's ``forward`` directly: at batch 1 the module-call machinery (hook dispatch) costs about as
             # much as the matmuls themselves (sb3-gqn adds no hooks; ``register_forward_hook`` on layers is not run).
-            for layer in block:
+            for layer in block.children():
                 output = layer.forward(output)
             hidden = hidden + output if skip else output
         return hidden

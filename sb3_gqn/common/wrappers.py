@@ -44,8 +44,8 @@ class BinGrid:
     :param bins: bins per dimension (at least 2)
     """
 
-    def __init__(self, box: spaces.Box, bins: int):
-        check_finite_box(box, "Discretization")
+    def __init__(self, box: spaces.Space, bins: int):
+        box = check_finite_box(box, "Discretization")
         if isinstance(bins, bool) or not isinstance(bins, (int, np.integer)) or bins < 2:
             raise ValueError(f"bins must be an integer >= 2, got {bins!r}")
         self.box = box

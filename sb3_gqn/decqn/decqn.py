@@ -52,7 +52,7 @@ class DecQN(GQN):
         if isinstance(bins, (bool, np.bool_)) or not isinstance(bins, (int, np.integer)):
             pair = " use GQN for (initial, final) pairs" if isinstance(bins, (tuple, list)) else ""
             raise ValueError(f"bins must be a single int >= 2 for DecQN, got {bins!r};{pair}".rstrip(";"))
-        super().__init__(*args, bins=int(bins), growth=None, **kwargs)
+        super().__init__(*args, **{**kwargs, "bins": int(bins), "growth": None})  # args: policy, env, learning_rate, ...
 
     def learn(
         self: SelfDecQN,

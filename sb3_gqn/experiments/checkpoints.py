@@ -60,15 +60,18 @@ class ReplayableResets(gym.Wrapper):
         self._replay: dict[str, Any] | None = None
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
-        generator = self.env.unwrapped.np_random  # a Generator, or a legacy RandomState (shimmy's dm_control envs)
+        # a Generator, or a legacy RandomState (shimmy's dm_control envs)
+        generator: np.random.Generator | np.random.RandomState = self.env.unwrapped.np_random
         if self._replay is not None and kwargs.get("seed") is None:
-            if hasattr(generator, "bit_generator"):
-                generator.bit_generator.state = self._replay
-            else:
+            if isinstance(generator, np.random.RandomState):
                 generator.set_state(self._replay)
+            else:
+                generator.bit_generator.state = self._replay
             self._replay = None
-        legacy = not hasattr(generator, "bit_generator")
-        self.state_before_reset = generator.get_state() if legacy else generator.bit_generator.state
+        if isinstance(generator, np.random.RandomState):
+            self.state_before_reset = generator.get_state(legacy=False)
+        else:
+            self.state_before_reset = dict(generator.bit_generator.state)
         return self.env.reset(**kwargs)
 
     def replay_next_reset(self, state: dict[str, Any] | None) -> None:

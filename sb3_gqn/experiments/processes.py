@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Hashable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from types import FrameType
-from typing import Any
+from typing import Any, TypeVar
 
 __all__ = ["run_in_processes"]
 
@@ -37,11 +37,15 @@ def _terminate_children(deadline_seconds: float = 30.0) -> None:
             child.join(timeout=1.0)
 
 
+#: a call's key: what names it to the callbacks
+Key = TypeVar("Key", bound=Hashable)
+
+
 def run_in_processes(
-    calls: Sequence[tuple[Hashable, Callable[..., Any], tuple[Any, ...]]],
+    calls: Sequence[tuple[Key, Callable[..., Any], tuple[Any, ...]]],
     jobs: int,
-    on_finished: Callable[[Hashable], None] | None = None,
-    on_wait: Callable[[list[Hashable]], None] | None = None,
+    on_finished: Callable[[Key], None] | None = None,
+    on_wait: Callable[[list[Key]], None] | None = None,
     report_every: float = 15.0,
 ) -> None:
     """Run each ``(key, function, args)`` of ``calls`` in one of ``jobs`` spawned processes.
@@ -57,7 +61,7 @@ def run_in_processes(
     previous_handler = signal.signal(signal.SIGTERM, _interrupt) if in_main_thread else None
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"))
     try:
-        futures: dict[Future, Hashable] = {pool.submit(function, *args): key for key, function, args in calls}
+        futures: dict[Future, Key] = {pool.submit(function, *args): key for key, function, args in calls}
         last_report = time.monotonic()
         while futures:
             # blocks until a call finishes or the next report is due (a signal's KeyboardInterrupt still ends it)

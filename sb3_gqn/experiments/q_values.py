@@ -14,6 +14,8 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.callbacks import BaseCallback
 
+from sb3_gqn.gqn.gqn import GQN
+
 # Pendulum-v1's state grid for the Q-value picture (figure 2): angle x angular velocity
 PENDULUM_ANGLES = np.linspace(-np.pi, np.pi, 41)
 PENDULUM_VELOCITIES = np.linspace(-8.0, 8.0, 41)
@@ -30,33 +32,39 @@ class QValueSnapshots(BaseCallback):
         self.run_dir = Path(run_dir)
         self.level = 0
 
+    @property
+    def gqn(self) -> GQN:
+        """The model trained: a GQN (or DecQN)."""
+        assert isinstance(self.model, GQN), f"Q-value snapshots need a GQN or DecQN, got {type(self.model).__name__}"
+        return self.model
+
     def _snapshot(self, level: int) -> None:
         angle, velocity = np.meshgrid(PENDULUM_ANGLES, PENDULUM_VELOCITIES, indexing="ij")
         observations = np.stack([np.cos(angle), np.sin(angle), velocity], axis=-1).reshape(-1, 3).astype(np.float32)
         with th.no_grad():
-            utilities = self.model.q_net(th.as_tensor(observations, device=self.model.device))  # type: ignore[attr-defined]
+            utilities = self.gqn.q_net(th.as_tensor(observations, device=self.gqn.device))
         utilities = utilities[:, 0, :].cpu().numpy().reshape(len(PENDULUM_ANGLES), len(PENDULUM_VELOCITIES), -1)
-        grid = getattr(self.model, "action_grid", None)
+        grid = self.gqn.action_grid
         np.savez(
             self.run_dir / f"q_level{level}.npz",
             utilities=utilities,
             bin_values=grid.values[0] if grid is not None else np.arange(utilities.shape[-1], dtype=np.float32),
-            active_bins=self.model.bin_levels[level],  # type: ignore[attr-defined]
-            max_bins=self.model.bin_levels[-1],  # type: ignore[attr-defined]
+            active_bins=self.gqn.bin_levels[level],
+            max_bins=self.gqn.bin_levels[-1],
             angles=PENDULUM_ANGLES,
             velocities=PENDULUM_VELOCITIES,
             step=self.num_timesteps,
         )
 
     def _on_step(self) -> bool:
-        level = self.model.growth_level  # type: ignore[attr-defined]
+        level = self.gqn.growth_level
         if level != self.level:  # the network as it was trained at the previous level
             self._snapshot(self.level)
             self.level = level
         return True
 
     def _on_training_end(self) -> None:
-        self._snapshot(self.model.growth_level)  # type: ignore[attr-defined]
+        self._snapshot(self.gqn.growth_level)
 
 
 def save_q_snapshot(run_dir: Path) -> QValueSnapshots:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
 import tempfile
 import time
@@ -64,7 +65,8 @@ def _progress_board(name: str) -> Any:
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
 
     here = NodeAffinitySchedulingStrategy(node_id=ray.get_runtime_context().get_node_id(), soft=False)
-    return ProgressBoard.options(name=name, scheduling_strategy=here).remote()
+    # @ray.remote made ProgressBoard an actor class (with options); mypy sees the class as written
+    return ProgressBoard.options(name=name, scheduling_strategy=here).remote()  # type: ignore[attr-defined]
 
 
 def train_remotely(
@@ -137,7 +139,7 @@ def run_on_ray(
 
     started_here = not ray.is_initialized()
     if started_here:
-        ray.init(address=address, logging_level="WARNING", log_to_driver=False)
+        ray.init(address=address, logging_level=logging.WARNING, log_to_driver=False)
     try:
         board = _progress_board(progress_board_name(out))
         task = ray.remote(train_remotely).options(num_cpus=threads, num_gpus=gpus, max_retries=retries, retry_exceptions=False)

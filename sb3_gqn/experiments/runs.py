@@ -246,7 +246,7 @@ def _train(
         trained_agent=str(checkpoint / "model.zip") if checkpoint is not None else "",
     )
     try:
-        model, _ = manager.setup_experiment()  # type: ignore[misc]
+        experiment = manager.setup_experiment()
     except Exception as error:  # a checkpoint that is whole by its record but does not load: the one before it
         if checkpoint is None:
             raise
@@ -256,6 +256,8 @@ def _train(
         )
         mark_damaged(checkpoint)
         return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
+    assert experiment is not None  # rl-zoo3 returns None only when it optimizes hyperparameters
+    model, _ = experiment
     eval_env = make_eval_env(spec)
 
     def on_progress(steps: int) -> None:
@@ -289,7 +291,8 @@ def _train(
     try:  # rl-zoo3's learn restarts the step counter; a resumed run continues it up to the budget
         model.learn(spec.steps - model.num_timesteps, callback=callbacks, reset_num_timesteps=checkpoint is None)
     finally:
-        model.env.close()
+        if model.env is not None:
+            model.env.close()
     model.save(run_dir / "model.zip")
     summary = {
         "run": spec.name,

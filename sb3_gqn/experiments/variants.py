@@ -120,10 +120,10 @@ def warm_started(algo: str, variants: Mapping[str, Variant] = VARIANTS) -> bool:
     return init == "interpolate"
 
 
-SHORT_SUITE = dict(
+SHORT_SUITE: dict[str, Any] = dict(
     algos=["gqn-linear", "decqn-2", "decqn-9", "sac"], envs=["Pendulum-v1"], penalties=[0.1], seeds=[0], steps=10_000
 )
-FULL_SUITE = dict(
+FULL_SUITE: dict[str, Any] = dict(
     algos=["gqn-adaptive", "gqn-linear", "decqn-2", "decqn-9", "sac", "td3"],
     envs=[
         "dm_control/cartpole-swingup-v0",

@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import warnings
 from pathlib import Path
+from typing import Any
 
 import torch as th
 from gymnasium import spaces
@@ -93,6 +94,7 @@ def export_onnx(
         external_data = weight_bytes > ONNX_EMBEDDED_LIMIT_BYTES
     example = policy.example_observation(batch_size=2)
     batch = th.export.Dim("batch")
+    dynamic_shapes: dict[str, Any]
     if isinstance(example, dict):
         input_names = list(example)
         dynamic_shapes = {"observation": {key: {0: batch} for key in example}}

@@ -76,6 +76,10 @@ class DeployedPolicy(nn.Module):
     :param vec_normalize: the ``VecNormalize`` the model was trained with, if any
     """
 
+    #: the registered buffers (nn.Module's attribute lookup types them as ``Tensor | Module``)
+    active_bins_mask: th.Tensor
+    bin_values: th.Tensor
+
     def __init__(self, model: GQN, vec_normalize: VecNormalize | None = None):
         super().__init__()
         policy = model.policy

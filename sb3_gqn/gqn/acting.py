@@ -96,11 +96,15 @@ class Acting:
     discrete_action_space: spaces.Space
     action_grid: BinGrid | None
     bin_levels: list[int]
-    deployed_bins: int
     growth_schedule: AdaptiveGrowth | None
     _deployed_level: int | None
     _active_bin_indices: np.ndarray
     _learning_bins_mask: th.Tensor
+
+    if TYPE_CHECKING:  # GrowingResolution's property, ahead of this class in GQN's bases
+
+        @property
+        def deployed_bins(self) -> int: ...
 
     def _on_step(self) -> None:
         """Update the exploration rate after every environment step."""
@@ -119,6 +123,7 @@ class Acting:
         """Refuse non-finite rewards and observations before they reach the replay buffer (they would poison every
         Q-value)."""
         check_finite_transition(reward, new_obs, infos, self.num_timesteps, self.observation_space)
+        # a mixin: the method is OffPolicyAlgorithm's, after this class in GQN's bases (mypy looks in object)
         super()._store_transition(replay_buffer, buffer_action, new_obs, reward, dones, infos)  # type: ignore[misc]
 
     def _sample_action(

@@ -12,7 +12,7 @@ from stable_baselines3.common.buffers import ReplayBuffer
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.off_policy_algorithm import OffPolicyAlgorithm
 from stable_baselines3.common.policies import BasePolicy
-from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, Schedule
+from stable_baselines3.common.type_aliases import GymEnv, MaybeCallback, ReplayBufferSamples, Schedule
 from stable_baselines3.common.utils import LinearSchedule, polyak_update
 
 from sb3_gqn.common.arguments import (
@@ -22,7 +22,12 @@ from sb3_gqn.common.arguments import (
     check_total_timesteps,
     warn_if_learn_does_not_train,
 )
-from sb3_gqn.common.buffers import PrioritizedSampling, check_replay_buffer_kwargs, replay_buffer_settings
+from sb3_gqn.common.buffers import (
+    PrioritizedReplayBufferSamples,
+    PrioritizedSampling,
+    check_replay_buffer_kwargs,
+    replay_buffer_settings,
+)
 from sb3_gqn.common.envs import check_action_space, check_policy_fits, resolve_env
 from sb3_gqn.common.finite import check_finite_observation
 from sb3_gqn.common.masking import EXPLORATION_MODES
@@ -187,18 +192,19 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         decoding, decoding_kwargs = checked_decoding(decoding, decoding_kwargs)
         if bins is not None:
             bins = checked_bins(bins)  # a bad value fails here, before the env is made
-        env = resolve_env(env)  # type: ignore[assignment]
-        if env is not None:
-            check_action_space(env.action_space)
-            check_policy_fits(policy, env.observation_space)
+        made_env = resolve_env(env)
+        if made_env is not None:
+            check_action_space(made_env.action_space)
+            check_policy_fits(policy, made_env.observation_space)
             if bins is None:  # the env's own choices for a Discrete/MultiDiscrete space (default_bins)
-                bins, grows = default_bins(env.action_space)
+                bins, grows = default_bins(made_env.action_space)
                 growth = growth if grows else None
         self.bins = bins
         self.bin_levels = bin_levels_from(bins) if bins is not None else []
         super().__init__(
-            policy, env, learning["learning_rate"], learning["buffer_size"], learning["learning_starts"],
-            learning["batch_size"], learning["tau"], learning["gamma"], train_freq, learning["gradient_steps"],
+            policy, made_env if made_env is not None else env, learning["learning_rate"], learning["buffer_size"],
+            learning["learning_starts"], learning["batch_size"], learning["tau"], learning["gamma"], train_freq,
+            learning["gradient_steps"],
             action_noise=None,  # exploration is epsilon-greedy over the active bins
             replay_buffer_class=replay_buffer_class, replay_buffer_kwargs=replay_buffer_kwargs,
             optimize_memory_usage=optimize_memory_usage, n_steps=learning["n_steps"],
@@ -294,9 +300,11 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         # Eq. 3's A^g: the deployed level (the growth level unless an opened level is on probation, whose bins then
         # learn "this bin now, then the deployed policy")
         active_bins_mask = self.policy.active_bins_mask
-        prioritized = isinstance(self.replay_buffer, PrioritizedSampling)
-        if prioritized:  # beta for this point of training (constant unless the buffer anneals it)
-            self.replay_buffer.anneal_beta(self._current_progress_remaining)  # type: ignore[union-attr]
+        buffer = self.replay_buffer
+        assert buffer is not None, "the replay buffer is made by _setup_model"
+        prioritized = buffer if isinstance(buffer, PrioritizedSampling) else None
+        if prioritized is not None:  # beta for this point of training (constant unless the buffer anneals it)
+            prioritized.anneal_beta(self._current_progress_remaining)
 
         critics = self.policy.critics
         online_parameters = self.policy.online_parameters()
@@ -305,11 +313,15 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         precision = matmul_precision(self.update_precision, self.device) or contextlib.nullcontext()
         losses, q_values = [], []
         for _ in range(gradient_steps):
-            replay_data = self.replay_buffer.sample(batch_size, env=self._vec_normalize_env)  # type: ignore[union-attr]
+            if prioritized is not None:
+                prioritized_data = prioritized.sample(batch_size, env=self._vec_normalize_env)
+                replay_data: ReplayBufferSamples | PrioritizedReplayBufferSamples = prioritized_data
+                weights: th.Tensor | None = prioritized_data.weights
+            else:
+                replay_data, weights = buffer.sample(batch_size, env=self._vec_normalize_env), None
             # n-step replay returns gamma ** k (k = steps actually summed); plain replay uses gamma
             discounts = replay_data.discounts if replay_data.discounts is not None else self.gamma
 
-            weights = replay_data.weights if prioritized else None
             actions = replay_data.actions.long().view(batch_size, self.policy.action_dims)
             with th.no_grad():
                 with precision:
@@ -336,9 +348,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
             if self.max_grad_norm is not None:
                 clip_grad_norm(online_parameters, self.max_grad_norm)
             self.policy.optimizer.step()
-            if prioritized:  # the TD errors become the sampled transitions' new priorities
+            if prioritized is not None:  # the TD errors become the sampled transitions' new priorities
                 # (after the step: the backward pass still finds the forward's activations in cache, ~3 % faster)
-                self.replay_buffer.update_priorities(replay_data.indices, abs_td_errors)  # type: ignore[union-attr]
+                prioritized.update_priorities(prioritized_data.indices, abs_td_errors)
 
             if self.acting_tau is not None:  # the averaged network predict() acts on follows the online one
                 self.policy.update_acting_networks(self.acting_tau)
@@ -354,9 +366,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self.logger.record("train/loss", th.stack(losses).mean().item())
         self.logger.record("train/q_mean", th.stack(q_values).mean().item())
         self.logger.record("growth/active_bins", self.active_bins)
-        if prioritized:
-            self.logger.record("replay/importance_sampling_exponent", self.replay_buffer.beta)  # type: ignore[union-attr]
-            self.logger.record("replay/max_priority", self.replay_buffer.max_priority)  # type: ignore[union-attr]
+        if prioritized is not None:
+            self.logger.record("replay/importance_sampling_exponent", prioritized.beta)
+            self.logger.record("replay/max_priority", prioritized.max_priority)
 
     # ----------------------------------------------------------------------------------------------
     # SB3 hooks

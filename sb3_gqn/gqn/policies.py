@@ -3,6 +3,7 @@ active-bin mask (paper eq. 3)."""
 
 from __future__ import annotations
 
+import copy
 from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
@@ -166,11 +167,12 @@ class GQNPolicy(BasePolicy):
             target.set_training_mode(False)
         for (online, _), acting in zip(self.critics, self.acting_q_nets):
             acting.load_state_dict(online.state_dict())
-            acting.set_training_mode(False)
+            acting.train(False)
         self._mode_dependent = any(isinstance(module, MODE_DEPENDENT_LAYERS) for module in self.q_net.modules())
         # every module of the online networks, whose training flags set_training_mode sets
         self._online_modules = [module for online, _ in self.critics for module in online.modules()]
         # Only the online networks are optimized (the target nets' parameters stay out of the optimizer)
+        # SB3 types optimizer_class as torch's base Optimizer, whose constructor takes no lr
         self.optimizer = self.optimizer_class(  # type: ignore[call-arg]
             self.online_parameters(),
             lr=lr_schedule(1),
@@ -180,6 +182,7 @@ class GQNPolicy(BasePolicy):
     @property
     def critics(self) -> list[tuple[DecoupledQNetwork, DecoupledQNetwork]]:
         """``(online, target)`` network of every critic, the first one's (``q_net``, ``q_net_target``) first."""
+        # the ModuleLists hold make_q_net's DecoupledQNetworks; torch types their items as Module
         return [(self.q_net, self.q_net_target), *zip(self.extra_q_nets, self.extra_q_nets_target, strict=True)]  # type: ignore[list-item]
 
     def online_parameters(self) -> list[nn.Parameter]:
@@ -190,7 +193,7 @@ class GQNPolicy(BasePolicy):
         """The networks greedy actions maximize over: the Polyak-averaged copies when the policy keeps them
         (``averaged_acting``) and ``online`` is ``False``, else every critic's online network."""
         if self.averaged_acting and not online:
-            return list(self.acting_q_nets)  # type: ignore[arg-type]
+            return list(self.acting_q_nets)  # type: ignore[arg-type]  # DecoupledQNetworks, as in critics
         return [online_net for online_net, _ in self.critics]
 
     @th.no_grad()
@@ -287,8 +290,8 @@ class GQNPolicy(BasePolicy):
         """``nn.Module``'s, across a change of ``averaged_acting`` (``acting_tau`` set or unset when a model is loaded):
         a state without the averaged acting networks loads into a policy that keeps them, which then start as copies
         of the loaded online networks, and a state with them into a policy without them, which drops them."""
-        state = OrderedDict(state_dict)
-        metadata = getattr(state_dict, "_metadata", None)  # module versions, as nn.Module keeps them
+        # a shallow copy keeps what nn.Module's state dicts carry beside the tensors (the module versions)
+        state = copy.copy(state_dict) if isinstance(state_dict, OrderedDict) else OrderedDict(state_dict)
         saved_acting = [key for key in state if key.startswith("acting_q_nets.")]
         if self.averaged_acting and not saved_acting:
             online_prefixes = ["q_net.", *(f"extra_q_nets.{index}." for index in range(self.n_critics - 1))]
@@ -298,8 +301,6 @@ class GQNPolicy(BasePolicy):
         elif not self.averaged_acting:
             for key in saved_acting:
                 del state[key]
-        if metadata is not None:
-            state._metadata = metadata  # type: ignore[attr-defined]
         return super().load_state_dict(state, strict, assign)
 
     def set_training_mode(self, mode: bool) -> None:

@@ -7,7 +7,7 @@ copies of one or more of them with the active-bin mask (paper eq. 3).
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import torch as th
@@ -147,12 +147,15 @@ class DecoupledQNetwork(BasePolicy):
         # .to() act on them; replacing a layer object afterwards is not supported.
         self.layer_chain: list[Callable[[th.Tensor], th.Tensor]] | None = None
         if isinstance(self.torso, DecoupledMLP) and not any(self.torso.skips):
-            self.layer_chain = [layer.forward for block in self.torso.blocks for layer in block] + [self.head.forward]
+            layers = [layer for block in self.torso.blocks for layer in block.children()]
+            self.layer_chain = [layer.forward for layer in layers] + [self.head.forward]
 
     def forward(self, obs: PyTorchObs) -> th.Tensor:
         """Utilities ``Q^j(s, a^j)`` of shape ``(batch, action_dims, max_bins)``."""
         if self.flat_vector_observations:
-            features = obs if obs.dtype is th.float32 else obs.float()  # type: ignore[union-attr]
+            features = cast(th.Tensor, obs)  # flat_vector_observations: a Box space's tensor
+            if features.dtype is not th.float32:
+                features = features.float()
             if features.dim() > 2:
                 features = features.flatten(1)
         else:

@@ -240,7 +240,7 @@ class SavedFiles:
             if kwargs.get("bins") is not None and data.get("bins") is not None:
                 kwargs.update(levels_for_new_bins(path, data, kwargs["bins"]))
         with quiet_old_paths():  # a file of 0.1.0 names its classes by the old module paths, which its reader cannot change
-            return super().load(path, *args, **kwargs)  # type: ignore[misc]
+            return super().load(path, *args, **kwargs)  # type: ignore[misc]  # a mixin: SB3's load is next in the bases
 
     def save_replay_buffer(self, path: SavedPath) -> None:
         """Save the replay buffer (with its priorities) as a pickle of the filled rows only: a buffer of 1M rows

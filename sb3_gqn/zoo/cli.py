@@ -119,9 +119,10 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
             "        coef: 0.1",
         ]
         return "\n".join(lines)
-    bins, grows = default_bins(action_space)  # what GQN takes without bins: the same rule
-    if grows:
-        initial, final = bins  # type: ignore[misc]
+    assert action_space is not None  # a Discrete or an even MultiDiscrete space here
+    bins, _ = default_bins(action_space)  # what GQN takes without bins: the same rule
+    if isinstance(bins, tuple):  # they grow: (initial, final)
+        initial, final = bins
         lines += [f"  bins: [{initial}, {final}]         # the env's {final} choices, opened from {initial}"]
         lines += ["  growth: 'adaptive'"]
     else:

@@ -47,7 +47,8 @@ def register(algos: Iterable[str | None] = ()) -> None:
     utils.ALGOS.update(ZOO_ALGOS)
     utils.ALGOS.update({name: sbx_algorithm(name) for name in set(algos) if name in SBX_ALGOS})
     hyperparams_opt.HYPERPARAMS_SAMPLER.update({"gqn": sample_gqn_params, "decqn": sample_decqn_params})
-    hyperparams_opt.HYPERPARAMS_CONVERTER.update({"gqn": convert_gqn_params, "decqn": convert_gqn_params})
+    # rl-zoo3's dict is typed by its own converters, whose parameter has another name
+    hyperparams_opt.HYPERPARAMS_CONVERTER.update({"gqn": convert_gqn_params, "decqn": convert_gqn_params})  # type: ignore[dict-item]
     register_envs()
 
 
@@ -57,9 +58,9 @@ def loader_without_replay_memory(algo_class: type[GQN]) -> type[GQN]:
     rl-zoo3's enjoy and record_video do this only for their own off-policy algorithms.
     """
 
-    class Loader(algo_class):  # type: ignore[valid-type, misc]
+    class Loader(algo_class):  # type: ignore[valid-type, misc]  # a base class given as an argument: mypy needs a literal one
         @classmethod
-        def load(cls, path: Any, *args: Any, **kwargs: Any) -> GQN:  # type: ignore[override]
+        def load(cls, path: Any, *args: Any, **kwargs: Any) -> GQN:
             kwargs.setdefault("buffer_size", 1)
             return algo_class.load(path, *args, **kwargs)
 

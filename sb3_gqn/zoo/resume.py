@@ -37,13 +37,17 @@ def checkpoint_companion(trained_agent: str, kind: str) -> Path | None:
     return path if path.is_file() else None
 
 
+#: set on rl-zoo3's ``ExperimentManager`` once :func:`install` patched it
+RESUME_MARKER = "_sb3_gqn_resume"
+
+
 def install() -> None:
     """Patch rl-zoo3's ``ExperimentManager`` as the module docstring says (idempotent)."""
     from rl_zoo3.exp_manager import ExperimentManager
     from stable_baselines3.common.callbacks import CheckpointCallback
     from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
-    if getattr(ExperimentManager, "_sb3_gqn_resume", False):
+    if getattr(ExperimentManager, RESUME_MARKER, False):
         return
     create_callbacks = ExperimentManager.create_callbacks
     load_pretrained_agent = ExperimentManager._load_pretrained_agent
@@ -74,7 +78,8 @@ def install() -> None:
             normalized.training, normalized.norm_reward = False, False
         return normalized
 
+    # rl-zoo3 has no hook for these steps: the methods are replaced on its class (mypy refuses assigning methods)
     ExperimentManager.create_callbacks = create_callbacks_with_buffers  # type: ignore[method-assign]
     ExperimentManager._load_pretrained_agent = load_checkpoint_buffer  # type: ignore[method-assign]
     ExperimentManager._maybe_normalize = normalize_from_checkpoint  # type: ignore[method-assign]
-    ExperimentManager._sb3_gqn_resume = True  # type: ignore[attr-defined]
+    setattr(ExperimentManager, RESUME_MARKER, True)

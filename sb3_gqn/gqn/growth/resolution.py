@@ -19,6 +19,8 @@ from sb3_gqn.common.masking import active_bin_indices, active_bin_mask
 from sb3_gqn.gqn.growth.schedules import interpolation_neighbours
 
 if TYPE_CHECKING:
+    from stable_baselines3.common.logger import Logger
+
     from sb3_gqn.gqn.growth.schedules import AdaptiveGrowth
     from sb3_gqn.gqn.policies import GQNPolicy
 
@@ -41,6 +43,7 @@ class GrowingResolution:
     #: the model's whole life, so its events stay in step order across save, load and reset counters
     growth_step_offset: int = 0
     verbose: int
+    logger: Logger
     _active_bin_indices: np.ndarray
     _learning_bins_mask: th.Tensor
 
@@ -100,7 +103,7 @@ class GrowingResolution:
             "last_growth_step": self.growth_step,
         }
         for key in keys:
-            self.logger.record(f"growth/{key}", values[key])  # type: ignore[attr-defined]
+            self.logger.record(f"growth/{key}", values[key])
 
     def grow(self, level: int | None = None, reason: str = "manual", probation: bool = False) -> None:
         """Open resolution level ``level`` (default: the next one) for every action dimension.

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import MISSING, dataclass, field, fields
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeGuard
 
 import numpy as np
 from gymnasium import spaces
@@ -39,7 +39,7 @@ DEFAULT_GROWTH_INIT = "interpolate"
 RETURN_SOURCES = ("evaluation", "training")
 
 
-def _is_bin_count(value: object) -> bool:
+def _is_bin_count(value: object) -> TypeGuard[int | np.integer]:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
@@ -79,7 +79,7 @@ def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
         ``(2.0, 9)``, or bins that cannot nest
     """
     if _is_bin_count(bins):
-        return nested_bin_levels(int(bins), int(bins))  # type: ignore[arg-type]
+        return nested_bin_levels(int(bins), int(bins))
     if isinstance(bins, (tuple, list)) and len(bins) == 2:
         return nested_bin_levels(bins[0], bins[1])
     raise ValueError(f"bins must be an int >= 2 or an (initial, final) pair of ints, got {bins!r}")
@@ -209,7 +209,8 @@ class GrowthDecision:
 
     def describe_probation(self) -> str:
         """One line for a probation return: held, or deployed after the last allowed try."""
-        held = "holds" if probation_holds(self.probation_reference, self.current_return) else "misses, last try"  # type: ignore[arg-type]
+        assert self.probation_reference is not None, "a probation decision has the opened level's reference return"
+        held = "holds" if probation_holds(self.probation_reference, self.current_return) else "misses, last try"
         return f"probation return {self.current_return:.2f} {held} against {self.probation_reference:.2f}"
 
 
@@ -311,7 +312,8 @@ class AdaptiveGrowth:
         state.setdefault("level_returns", list(state.get("history", [])))
         for item in fields(self):
             if item.name not in state:
-                default = item.default_factory() if item.default is MISSING else item.default  # type: ignore[misc]
+                factory = item.default_factory
+                default = factory() if item.default is MISSING and callable(factory) else item.default
                 state[item.name] = self.BEFORE_FIELD.get(item.name, default)
         self.__dict__.update(state)
 
