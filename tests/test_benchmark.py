@@ -339,10 +339,51 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     assert block(page.README, "results") == page.task_table(table)
     if len(page.smooth_control_runs()):
         assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
+    assert block(page.PAGE, "smooth-default") == page.smooth_default_block()
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
             suite_table = page.load([path / "results.csv"])
             assert block(page.RESULTS / f"{name}.md", name) == page.suite_block(suite_table, agents)
+
+
+def test_the_relative_decoding_table_by_hand(tmp_path, monkeypatch):
+    """door-open: the runner's two runs end at task return 200 and 300 read with the argmax, 100 and 250 with the
+    relative decoding (SM 0.004, 0.006 and 0.001, 0.003); paired differences -100 and -50: mean -75, and the bootstrap
+    replicates of two values are -100, -75 or -50. SAC's SM is 0.002 (two seeds), so SM 2.50x and 1.00x SAC's. The
+    readings file: two models at 10 and 20 with the argmax, 30 and 20 with the relative decoding: +20 and 0, mean 10
+    [0, 20]; no SAC runs for its env ("-")."""
+    import pandas as pd
+
+    page = results_page()
+    door, reacher = "sb3_gqn/metaworld-door-open-v3", "dm_control/reacher-easy-v0"
+
+    def row(algo, seed, task_return, sm, decoding=""):
+        return {"algo": algo, "env": door, "penalty": 0.5, "seed": seed, "step": 50_000, "return": task_return,
+                "task_return": task_return, "smoothness": sm, "action_change": 0.1, "decoding": decoding}  # fmt: skip
+
+    agent = page.SMOOTH_DEFAULT_AGENT
+    runs = [row(agent, 0, 100.0, 0.001), row(agent, 1, 250.0, 0.003)]
+    runs += [row(agent, 0, 200.0, 0.004, "argmax"), row(agent, 1, 300.0, 0.006, "argmax")]
+    early = [{**run, "step": 10_000, "task_return": 0.0} for run in runs]
+    (tmp_path / "evidence").mkdir()
+    pd.DataFrame(early + runs).to_csv(tmp_path / "evidence" / "results.csv", index=False)
+    (tmp_path / "sac").mkdir()
+    pd.DataFrame([{**row("sac", seed, 500.0, 0.002), "decoding": ""} for seed in (0, 1)]).to_csv(
+        tmp_path / "sac" / "results.csv", index=False
+    )
+    pd.DataFrame(
+        [{"model": f"m{index}", "decoding": decoding, "return": value, "task_return": value, "smoothness": 0.01}
+         for index, (greedy, relative) in enumerate([(10.0, 30.0), (20.0, 20.0)])
+         for decoding, value in [("greedy", greedy), ("relative 0.1", relative), ("softmax 0.3", 99.0)]]
+    ).to_csv(tmp_path / "decodings-reacher.csv", index=False)  # fmt: skip
+    monkeypatch.setattr(page, "SMOOTH_DEFAULT_SAC", {door: tmp_path / "sac"})
+    monkeypatch.setattr(page, "SMOOTH_DEFAULT_READINGS", {"decodings-reacher.csv": {"env": reacher, "source": "models"}})
+    body = page.smooth_default_block(tmp_path).splitlines()
+    assert body[2] == (
+        "| door-open-v3 | runner, paired readings | 2 | 250 [200, 300] | 175 [100, 250] | -75 [-100, -50] | 2.50x | 1.00x |"
+    )
+    assert body[3] == "| reacher-easy | models | 2 | 15 [10, 20] | 25 [20, 30] | 10 [0, 20] | - | - |"
+    assert len(body) == 4
 
 
 def test_the_smooth_control_table_by_hand(tmp_path):

@@ -12,6 +12,7 @@ written by hand. Run from the repository root after extending a table with the c
 from __future__ import annotations
 
 import json
+import math
 import sys
 from collections.abc import Mapping
 from pathlib import Path
@@ -60,6 +61,16 @@ SMOOTHNESS_GOAL = float(_CHOICES["smooth_control"]["smoothness_goal"])
 #: page name -> the runner's output folder and the agents shown (runner name: label); each page
 #: ``docs/results/<name>.md`` gets its table and the curves once the folder's ``results.csv`` exists
 SUITES = {name: (Path(suite["folder"]), dict(suite["agents"])) for name, suite in _CHOICES["suites"].items()}
+#: The relative decoding's evidence (smooth-control.md): the runner's runs of the agent that acts on it (each evaluation
+#: paired with the argmax on the same episodes), final models read with both decodings, and SAC's committed tables
+SMOOTH_DEFAULT = Path(_CHOICES["smooth_default"]["folder"])
+SMOOTH_DEFAULT_AGENT: str = _CHOICES["smooth_default"]["agent"]
+#: decodings-<task>.csv's decoding column -> "argmax" or "relative"
+SMOOTH_DEFAULT_DECODINGS: dict[str, str] = _CHOICES["smooth_default"]["decodings"]
+#: decodings file (under SMOOTH_DEFAULT) -> its models' env and where the models come from
+SMOOTH_DEFAULT_READINGS: dict[str, dict[str, str]] = _CHOICES["smooth_default"]["readings"]
+#: env -> the committed table that holds SAC's runs at the same budget and penalty
+SMOOTH_DEFAULT_SAC: dict[str, Path] = {env: Path(table) for env, table in _CHOICES["smooth_default"]["sac"].items()}
 
 
 def research_variants() -> dict[str, Variant]:
@@ -296,6 +307,54 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     return "\n".join(lines).strip()
 
 
+def paired_decodings_row(task: str, source: str, argmax: pd.DataFrame, relative: pd.DataFrame) -> str:
+    """One row of :func:`smooth_default_block`: ``argmax`` and ``relative`` hold the same runs (or models) by index."""
+    index = argmax.index.intersection(relative.index)
+    argmax, relative = argmax.loc[index], relative.loc[index]
+    sac_table = SMOOTH_DEFAULT_SAC.get(task)
+    sac_sm = math.nan
+    if sac_table is not None:
+        sac = final_rows(load([sac_table / "results.csv"]))
+        sac_sm = float(sac[(sac["env"] == task) & (sac["algo"] == "sac")]["smoothness"].mean())
+    ratios = [f"{runs['smoothness'].mean() / sac_sm:.2f}x" if sac_sm > 0 else "-" for runs in (argmax, relative)]
+    difference = relative["task_return"].to_numpy() - argmax["task_return"].to_numpy()
+    cells = [
+        interval_cell(argmax["task_return"].to_numpy(), 0),
+        interval_cell(relative["task_return"].to_numpy(), 0),
+        interval_cell(difference, 0),
+        *ratios,
+    ]
+    return f"| {task_name(task)} | {source} | {len(index)} | " + " | ".join(cells) + " |"
+
+
+def smooth_default_block(path: Path = SMOOTH_DEFAULT) -> str:
+    """The relative decoding against the argmax, per task and source: the runner's runs of
+    :data:`SMOOTH_DEFAULT_AGENT` (final evaluation, both readings on the same episodes) and the final models of
+    :data:`SMOOTH_DEFAULT_READINGS`; task return of each decoding and their paired difference (mean [95 % interval]),
+    and each decoding's SM over SAC's (every committed seed of the same budget and penalty; "-" without SAC runs)."""
+    lines = [
+        "| task | source | runs | task return, argmax | task return, relative | relative - argmax | SM / SAC's, argmax "
+        "| SM / SAC's, relative |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    evidence = path / "evidence" / "results.csv"
+    if evidence.exists():
+        runs = final_rows(load([evidence]))
+        for env, env_runs in runs.groupby("env"):
+            by_algo = {algo: algo_runs.set_index("seed") for algo, algo_runs in env_runs.groupby("algo")}
+            argmax, relative = by_algo.get(f"{SMOOTH_DEFAULT_AGENT} (argmax)"), by_algo.get(SMOOTH_DEFAULT_AGENT)
+            if argmax is not None and relative is not None:
+                lines.append(paired_decodings_row(str(env), "runner, paired readings", argmax, relative))
+    for file, reading in SMOOTH_DEFAULT_READINGS.items():
+        models = pd.read_csv(path / file)
+        decoded = {
+            label: models[models["decoding"] == decoding].set_index("model")
+            for decoding, label in SMOOTH_DEFAULT_DECODINGS.items()
+        }
+        lines.append(paired_decodings_row(reading["env"], reading["source"], decoded["argmax"], decoded["relative"]))
+    return "\n".join(lines)
+
+
 #: the suite tables' early column: the evaluation nearest this fraction of each run's budget (10k of 50k steps), where
 #: the paper expects growth from 2 bins to start poorly on velocity control
 EARLY_FRACTION = 0.2
@@ -359,6 +418,7 @@ def run() -> int:
     replace_block(PAGE, "main", main_block(table, remedy, research_variants()))
     if len(remedy):
         replace_block(PAGE, "smooth-control", smooth_control_block(table))
+    replace_block(PAGE, "smooth-default", smooth_default_block())
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
@@ -368,7 +428,7 @@ def run() -> int:
             replace_block(RESULTS / f"{name}.md", name, suite_block(suite, agents))
             learning_curves(suite, path)
     print(
-        f"rebuilt {PAGE} (main, smooth-control), {README} (results, main-job, development) and the figures in "
+        f"rebuilt {PAGE} (main, smooth-control, smooth-default), {README} (results, main-job, development) and the figures in "
         f"{RESULTS / 'main'}"
     )
     return 0
