@@ -340,6 +340,9 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     if len(page.smooth_control_runs()):
         assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
     assert block(page.PAGE, "smooth-default") == page.smooth_default_block()
+    if (page.PAPER_SCALE / "results.csv").exists():
+        paper_scale = page.load([page.PAPER_SCALE / "results.csv"])
+        assert block(page.RESULTS / "paper-scale.md", "paper-scale") == page.paper_scale_block(paper_scale)
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
             suite_table = page.load([path / "results.csv"])
@@ -384,6 +387,40 @@ def test_the_relative_decoding_table_by_hand(tmp_path, monkeypatch):
     )
     assert body[3] == "| reacher-easy | models | 2 | 15 [10, 20] | 25 [20, 30] | 10 [0, 20] | - | - |"
     assert len(body) == 4
+
+
+def test_the_paper_scale_table_by_hand():
+    """finger-turn_hard, 40k-step runs (the first quarter: the 10k evaluation). GQN's two seeds end at return 100 and
+    200 (SM 0.002, 0.004; with the relative decoding 0.001) after -10 and -30 at 10k; DecQN-9's at 50 and 150 (SM
+    0.005) after -50 and -70. So GQN 150 [100, 200], first quarter -20 [-30, -10]; DecQN-9 100 [50, 150], -60 [-70,
+    -50]. The differences of means: first quarter +40, whose bootstrap replicates lie in [+20, +60] with each end at
+    probability 1/16 (both means at their extremes), so the 95 % interval is [+20, +60]; final +50 [-50, +150] alike
+    (100 - 150 and 200 - 50).
+    DecQN-2 and SAC did not run: no row, no comparison."""
+    import pandas as pd
+
+    from sb3_gqn.experiments.scores import with_paired_readings
+
+    page = results_page()
+
+    def row(algo, seed, step, value, sm=0.005, decoding=""):
+        return {"algo": algo, "env": "dm_control/finger-turn_hard-v0", "penalty": 0.5, "seed": seed, "step": step,
+                "return": value, "task_return": value + 1.0, "smoothness": sm, "decoding": decoding}  # fmt: skip
+
+    rows = [row("gqn-adaptive", 0, 10_000, -10.0), row("gqn-adaptive", 0, 20_000, 0.0)]
+    rows += [row("gqn-adaptive", 0, 40_000, 100.0, 0.002), row("gqn-adaptive", 1, 10_000, -30.0)]
+    rows += [row("gqn-adaptive", 1, 40_000, 200.0, 0.004)]
+    rows += [row("gqn-adaptive", seed, 40_000, 0.0, 0.001, "relative") for seed in (0, 1)]
+    rows += [row("decqn-9", seed, step, value) for seed, step, value in [(0, 10_000, -50.0), (0, 40_000, 50.0)]]
+    rows += [row("decqn-9", seed, step, value) for seed, step, value in [(1, 10_000, -70.0), (1, 40_000, 150.0)]]
+    body = page.paper_scale_block(with_paired_readings(pd.DataFrame(rows))).splitlines()
+    assert body[2] == "| finger-turn_hard | GQN | 2 | 150 [100, 200] | 151 [101, 201] | 0.0030 | 0.0010 | -20 [-30, -10] |"
+    assert body[3] == "| finger-turn_hard | DecQN-9 | 2 | 100 [50, 150] | 101 [51, 151] | 0.0050 | - | -60 [-70, -50] |"
+    assert body[4:] == [
+        "",
+        "- finger-turn_hard, first-quarter return, GQN - DecQN-9: +40 [+20, +60]",
+        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150]",
+    ]
 
 
 def test_the_smooth_control_table_by_hand(tmp_path):

@@ -307,6 +307,14 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
     return "\n".join(lines).strip()
 
 
+#: The paper-scale runs (paper-scale.md): folder, agents (runner name: label), the first quarter's share of a budget and
+#: the plan's comparisons (GQN, baseline, "early" or "final")
+PAPER_SCALE = Path(_CHOICES["paper_scale"]["folder"])
+PAPER_SCALE_AGENTS: dict[str, str] = _CHOICES["paper_scale"]["agents"]
+PAPER_SCALE_EARLY = float(_CHOICES["paper_scale"]["early_fraction"])
+PAPER_SCALE_COMPARISONS: list[tuple[str, str, str]] = [tuple(item) for item in _CHOICES["paper_scale"]["comparisons"]]
+
+
 def paired_decodings_row(task: str, source: str, argmax: pd.DataFrame, relative: pd.DataFrame) -> str:
     """One row of :func:`smooth_default_block`: ``argmax`` and ``relative`` hold the same runs (or models) by index."""
     index = argmax.index.intersection(relative.index)
@@ -353,6 +361,48 @@ def smooth_default_block(path: Path = SMOOTH_DEFAULT) -> str:
         }
         lines.append(paired_decodings_row(reading["env"], reading["source"], decoded["argmax"], decoded["relative"]))
     return "\n".join(lines)
+
+
+def early_means(table: pd.DataFrame, fraction: float) -> pd.DataFrame:
+    """Each run's mean return over its evaluations at steps up to ``fraction`` of its last one (one row per run)."""
+    keys = ["algo", "env", "penalty", "seed"]
+    early = table[table["step"] <= table.groupby(keys)["step"].transform("max") * fraction]
+    return early.groupby(keys, as_index=False)["return"].mean()
+
+
+def paper_scale_block(table: pd.DataFrame) -> str:
+    """The paper-scale runs per task: each agent's seeds, final return and task return (mean [95 % interval] over
+    seeds), SM with its own decoding and with the paired one (GQN and DecQN: argmax and relative), and the mean return
+    over the first quarter of the budget; then the plan's comparisons (:data:`PAPER_SCALE_COMPARISONS`) that both
+    agents ran, as differences of means [95 % interval]."""
+    final, early = final_rows(table), early_means(table, PAPER_SCALE_EARLY)
+    lines = [
+        "| task | agent | seeds | return | task return | SM | SM, relative | first-quarter return |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    readings: list[str] = []
+    for env, runs in final.groupby("env"):
+        task, env_early = task_name(str(env)), early[early["env"] == env]
+        for agent, label in PAPER_SCALE_AGENTS.items():
+            agent_runs, relative = runs[runs["algo"] == agent], runs[runs["algo"] == f"{agent} (relative)"]
+            if agent_runs.empty:
+                continue
+            cells = [
+                interval_cell(agent_runs["return"].to_numpy(), 0),
+                interval_cell(agent_runs["task_return"].to_numpy(), 0),
+                f"{agent_runs['smoothness'].mean():.4f}",
+                f"{relative['smoothness'].mean():.4f}" if len(relative) else "-",
+                interval_cell(env_early[env_early["algo"] == agent]["return"].to_numpy(), 0),
+            ]
+            lines.append(f"| {task} | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
+        for agent, baseline, when in PAPER_SCALE_COMPARISONS:
+            source = env_early if when == "early" else runs
+            values = [source[source["algo"] == name]["return"].to_numpy() for name in (agent, baseline)]
+            if all(len(value) for value in values):
+                reading = "first-quarter return" if when == "early" else "final return"
+                names = f"{PAPER_SCALE_AGENTS[agent]} - {PAPER_SCALE_AGENTS[baseline]}"
+                readings.append(f"- {task}, {reading}, {names}: {difference_cell(*values)}")
+    return "\n".join(lines + (["", *readings] if readings else []))
 
 
 #: the suite tables' early column: the evaluation nearest this fraction of each run's budget (10k of 50k steps), where
@@ -419,6 +469,8 @@ def run() -> int:
     if len(remedy):
         replace_block(PAGE, "smooth-control", smooth_control_block(table))
     replace_block(PAGE, "smooth-default", smooth_default_block())
+    if (PAPER_SCALE / "results.csv").exists():
+        replace_block(RESULTS / "paper-scale.md", "paper-scale", paper_scale_block(load([PAPER_SCALE / "results.csv"])))
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
@@ -428,8 +480,8 @@ def run() -> int:
             replace_block(RESULTS / f"{name}.md", name, suite_block(suite, agents))
             learning_curves(suite, path)
     print(
-        f"rebuilt {PAGE} (main, smooth-control, smooth-default), {README} (results, main-job, development) and the figures in "
-        f"{RESULTS / 'main'}"
+        f"rebuilt {PAGE} (main, smooth-control, smooth-default), {README} (results, main-job, development), the suite "
+        f"pages, paper-scale.md and the figures in {RESULTS / 'main'}"
     )
     return 0
 
