@@ -98,12 +98,13 @@ def quiet_old_paths() -> Iterator[None]:
     """Import the 0.1.0 module paths without a ``DeprecationWarning`` inside the block: for reading files saved by
     0.1.0 (models and replay buffers name their classes by module path), which a user cannot change. The old paths
     first imported inside the block are dropped from ``sys.modules`` again when the last open block (in any thread)
-    ends, so that a user's own import of one afterwards still warns.
+    ends, so that a user's own import of one afterwards still warns. ``GQN.load`` and ``load_replay_buffer`` read
+    inside it themselves; other readers of such a file can use it too:
 
     .. code-block:: python
 
         with quiet_old_paths():
-            model = GQN.load("saved_by_0.1.0.zip")
+            buffer = load_from_pkl("buffer_saved_by_0.1.0.pkl")  # stable_baselines3.common.save_util
     """
     global _open_blocks
     with _blocks_lock:
