@@ -315,15 +315,23 @@ PAPER_SCALE_EARLY = float(_CHOICES["paper_scale"]["early_fraction"])
 PAPER_SCALE_COMPARISONS: list[tuple[str, str, str]] = [tuple(item) for item in _CHOICES["paper_scale"]["comparisons"]]
 
 
-def paired_decodings_row(task: str, source: str, argmax: pd.DataFrame, relative: pd.DataFrame) -> str:
-    """One row of :func:`smooth_default_block`: ``argmax`` and ``relative`` hold the same runs (or models) by index."""
+def sac_smoothness() -> dict[str, float]:
+    """SAC's mean final SM per task of :data:`SMOOTH_DEFAULT_SAC`, each committed table read once."""
+    tables = {table: final_rows(load([table / "results.csv"])) for table in set(SMOOTH_DEFAULT_SAC.values())}
+    smoothness = {}
+    for task, table in SMOOTH_DEFAULT_SAC.items():
+        sac = tables[table]
+        smoothness[task] = float(sac[(sac["env"] == task) & (sac["algo"] == "sac")]["smoothness"].mean())
+    return smoothness
+
+
+def paired_decodings_row(
+    task: str, source: str, argmax: pd.DataFrame, relative: pd.DataFrame, sac_sm: float = math.nan
+) -> str:
+    """One row of :func:`smooth_default_block`: ``argmax`` and ``relative`` hold the same runs (or models) by index;
+    ``sac_sm`` is SAC's SM on the task (NaN without SAC runs)."""
     index = argmax.index.intersection(relative.index)
     argmax, relative = argmax.loc[index], relative.loc[index]
-    sac_table = SMOOTH_DEFAULT_SAC.get(task)
-    sac_sm = math.nan
-    if sac_table is not None:
-        sac = final_rows(load([sac_table / "results.csv"]))
-        sac_sm = float(sac[(sac["env"] == task) & (sac["algo"] == "sac")]["smoothness"].mean())
     ratios = [f"{runs['smoothness'].mean() / sac_sm:.2f}x" if sac_sm > 0 else "-" for runs in (argmax, relative)]
     difference = relative["task_return"].to_numpy() - argmax["task_return"].to_numpy()
     cells = [
@@ -345,6 +353,7 @@ def smooth_default_block(path: Path = SMOOTH_DEFAULT) -> str:
         "| SM / SAC's, relative |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
+    sac_sm = sac_smoothness()
     evidence = path / "evidence" / "results.csv"
     if evidence.exists():
         runs = final_rows(load([evidence]))
@@ -352,14 +361,19 @@ def smooth_default_block(path: Path = SMOOTH_DEFAULT) -> str:
             by_algo = {algo: algo_runs.set_index("seed") for algo, algo_runs in env_runs.groupby("algo")}
             argmax, relative = by_algo.get(f"{SMOOTH_DEFAULT_AGENT} (argmax)"), by_algo.get(SMOOTH_DEFAULT_AGENT)
             if argmax is not None and relative is not None:
-                lines.append(paired_decodings_row(str(env), "runner, paired readings", argmax, relative))
+                lines.append(
+                    paired_decodings_row(str(env), "runner, paired readings", argmax, relative, sac_sm.get(str(env), math.nan))
+                )
     for file, reading in SMOOTH_DEFAULT_READINGS.items():
         models = pd.read_csv(path / file)
         decoded = {
             label: models[models["decoding"] == decoding].set_index("model")
             for decoding, label in SMOOTH_DEFAULT_DECODINGS.items()
         }
-        lines.append(paired_decodings_row(reading["env"], reading["source"], decoded["argmax"], decoded["relative"]))
+        task = reading["env"]
+        lines.append(
+            paired_decodings_row(task, reading["source"], decoded["argmax"], decoded["relative"], sac_sm.get(task, math.nan))
+        )
     return "\n".join(lines)
 
 
