@@ -343,6 +343,12 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     if (page.PAPER_SCALE / "results.csv").exists():
         paper_scale = page.load([page.PAPER_SCALE / "results.csv"])
         assert block(page.RESULTS / "paper-scale.md", "paper-scale") == page.paper_scale_block(paper_scale)
+        figures = [
+            page.RESULTS / link.split("](")[1].rstrip(")")
+            for link in block(page.RESULTS / "paper-scale.md", "paper-scale-figures").split("\n\n")
+        ]
+        # curves and a radar per task, one IQM
+        assert all(figure.exists() for figure in figures) and len(figures) == 2 * paper_scale["env"].nunique() + 1
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
             suite_table = page.load([path / "results.csv"])
@@ -391,11 +397,14 @@ def test_the_relative_decoding_table_by_hand(tmp_path, monkeypatch):
 
 def test_the_paper_scale_table_by_hand():
     """finger-turn_hard, 40k-step runs (the first quarter: the 10k evaluation). GQN's two seeds end at return 100 and
-    200 (SM 0.002, 0.004; with the relative decoding 0.001) after -10 and -30 at 10k; DecQN-9's at 50 and 150 (SM
-    0.005) after -50 and -70. So GQN 150 [100, 200], first quarter -20 [-30, -10]; DecQN-9 100 [50, 150], -60 [-70,
-    -50]. The differences of means: first quarter +40, whose bootstrap replicates lie in [+20, +60] with each end at
-    probability 1/16 (both means at their extremes), so the 95 % interval is [+20, +60]; final +50 [-50, +150] alike
-    (100 - 150 and 200 - 50).
+    200 (SM 0.002, 0.004; with the relative decoding 0.001) after -10 and -30 at 10k (and 3 at 20k for seed 0);
+    DecQN-9's at 50 and 150 (SM 0.005) after -50 and -70. So GQN 150 [100, 200], first quarter -20 [-30, -10], area
+    under the curve (the mean of each run's evaluations) 31 and 85, so 58 [31, 85]; DecQN-9 100 [50, 150], -60 [-70,
+    -50], area 0 and 40, so 20 [0, 40]. The differences of means: first quarter +40, whose bootstrap replicates lie in
+    [+20, +60] with each end at probability 1/16 (both means at their extremes), so the 95 % interval is [+20, +60];
+    final +50 [-50, +150] alike (100 - 150 and 200 - 50), area +38 [-9, +85] (31 - 40 and 85 - 0). SM over DecQN-9's:
+    0.003 / 0.005 = 0.60x, relative 0.001 / 0.005 = 0.20x; the task returns (return + 1) differ as the returns do,
+    an interval that holds 0: matched.
     DecQN-2 and SAC did not run: no row, no comparison."""
     import pandas as pd
 
@@ -407,20 +416,60 @@ def test_the_paper_scale_table_by_hand():
         return {"algo": algo, "env": "dm_control/finger-turn_hard-v0", "penalty": 0.5, "seed": seed, "step": step,
                 "return": value, "task_return": value + 1.0, "smoothness": sm, "decoding": decoding}  # fmt: skip
 
-    rows = [row("gqn-adaptive", 0, 10_000, -10.0), row("gqn-adaptive", 0, 20_000, 0.0)]
+    rows = [row("gqn-adaptive", 0, 10_000, -10.0), row("gqn-adaptive", 0, 20_000, 3.0)]
     rows += [row("gqn-adaptive", 0, 40_000, 100.0, 0.002), row("gqn-adaptive", 1, 10_000, -30.0)]
     rows += [row("gqn-adaptive", 1, 40_000, 200.0, 0.004)]
     rows += [row("gqn-adaptive", seed, 40_000, 0.0, 0.001, "relative") for seed in (0, 1)]
     rows += [row("decqn-9", seed, step, value) for seed, step, value in [(0, 10_000, -50.0), (0, 40_000, 50.0)]]
     rows += [row("decqn-9", seed, step, value) for seed, step, value in [(1, 10_000, -70.0), (1, 40_000, 150.0)]]
     body = page.paper_scale_block(with_paired_readings(pd.DataFrame(rows))).splitlines()
-    assert body[2] == "| finger-turn_hard | GQN | 2 | 150 [100, 200] | 151 [101, 201] | 0.0030 | 0.0010 | -20 [-30, -10] |"
-    assert body[3] == "| finger-turn_hard | DecQN-9 | 2 | 100 [50, 150] | 101 [51, 151] | 0.0050 | - | -60 [-70, -50] |"
+    assert body[2] == (
+        "| finger-turn_hard | GQN | 2 | 150 [100, 200] | 151 [101, 201] | 58 [31, 85] | -20 [-30, -10] | 0.0030 | 0.0010 |"
+    )
+    assert body[3] == (
+        "| finger-turn_hard | DecQN-9 | 2 | 100 [50, 150] | 101 [51, 151] | 20 [0, 40] | -60 [-70, -50] | 0.0050 | - |"
+    )
     assert body[4:] == [
         "",
         "- finger-turn_hard, first-quarter return, GQN - DecQN-9: +40 [+20, +60]",
-        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150]",
+        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150]; area under the curve: +38 [-9, +85]",
+        "- finger-turn_hard, SM, GQN over DecQN-9: argmax 0.60x, relative 0.20x; final task return, GQN - DecQN-9: "
+        "+50 [-50, +150] (matched)",
     ]
+
+
+def test_the_figures_block_links_each_known_figure_in_page_order(tmp_path):
+    """Curves first, then the IQM, then the radars, each kind by name; a figure of another kind is not linked."""
+    page = results_page()
+    folder = tmp_path / "suite"
+    names = ["smoothness_radar_b.png", "aggregate_iqm.png", "learning_curves_b_c0.5.png", "learning_curves_a_c0.5.png"]
+    body = page.figures_block([folder / name for name in [*names, "q_values_a.png"]], tmp_path)
+    assert body.split("\n\n") == [
+        "![learning curves, a_c0.5](suite/learning_curves_a_c0.5.png)",
+        "![learning curves, b_c0.5](suite/learning_curves_b_c0.5.png)",
+        "![IQM across tasks](suite/aggregate_iqm.png)",
+        "![smoothness, b](suite/smoothness_radar_b.png)",
+    ]
+
+
+def test_the_paper_scale_smoothness_reading_says_when_returns_differ():
+    """Two SAC runs at task return 300 (SM 0.002) against GQN's two at 100 and 120 (SM 0.001, argmax only): SM 0.50x
+    SAC's, and the task returns differ by -190 [-200, -180], an interval without 0: not matched."""
+    import pandas as pd
+
+    page = results_page()
+    runs = pd.DataFrame(
+        [
+            {"algo": "gqn-adaptive", "seed": 0, "task_return": 100.0, "smoothness": 0.001},
+            {"algo": "gqn-adaptive", "seed": 1, "task_return": 120.0, "smoothness": 0.001},
+            {"algo": "sbx-sac", "seed": 0, "task_return": 300.0, "smoothness": 0.002},
+            {"algo": "sbx-sac", "seed": 1, "task_return": 300.0, "smoothness": 0.002},
+        ]
+    )
+    assert page.smoothness_reading(runs, "gqn-adaptive", "sbx-sac") == (
+        "SM, GQN over SAC (SBX): argmax 0.50x; final task return, GQN - SAC (SBX): -190 [-200, -180] "
+        "(not matched: the SM ratio compares unequal returns)"
+    )
 
 
 def test_the_smooth_control_table_by_hand(tmp_path):

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
+from sb3_gqn.experiments.plots import aggregate, learning_curves, plot_suite, smoothness_radar
 from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
 from sb3_gqn.experiments.scores import final_rows
 from sb3_gqn.experiments.significance import difference_interval, mean_difference, mean_interval
@@ -385,18 +385,22 @@ def early_means(table: pd.DataFrame, fraction: float) -> pd.DataFrame:
 
 
 def paper_scale_block(table: pd.DataFrame) -> str:
-    """The paper-scale runs per task: each agent's seeds, final return and task return (mean [95 % interval] over
-    seeds), SM with its own decoding and with the paired one (GQN and DecQN: argmax and relative), and the mean return
-    over the first quarter of the budget; then the plan's comparisons (:data:`PAPER_SCALE_COMPARISONS`) that both
-    agents ran, as differences of means [95 % interval]."""
-    final, early = final_rows(table), early_means(table, PAPER_SCALE_EARLY)
+    """The paper-scale runs per task: each agent's seeds, final return and task return, the area under the curve (the
+    mean return over all of a run's evaluations, evenly spaced: the area over the budget) and the mean return over the
+    first quarter of the budget (each mean [95 % interval] over seeds), SM with its own decoding and with the paired
+    one (GQN and DecQN: argmax and relative); then the plan's comparisons (:data:`PAPER_SCALE_COMPARISONS`) that both
+    agents ran: ``early`` and ``final`` as differences of means [95 % interval] (``final`` with the area's beside it),
+    ``smoothness`` as the agent's SM with each decoding over the baseline's, with the final task returns' difference
+    and whether it matches (its interval holds 0)."""
+    final, early, area = final_rows(table), early_means(table, PAPER_SCALE_EARLY), early_means(table, 1.0)
     lines = [
-        "| task | agent | seeds | return | task return | SM | SM, relative | first-quarter return |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| task | agent | seeds | return | task return | area under the curve | first-quarter return | SM | SM, relative |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     readings: list[str] = []
     for env, runs in final.groupby("env"):
-        task, env_early = task_name(str(env)), early[early["env"] == env]
+        task = task_name(str(env))
+        env_early, env_area = early[early["env"] == env], area[area["env"] == env]
         for agent, label in PAPER_SCALE_AGENTS.items():
             agent_runs, relative = runs[runs["algo"] == agent], runs[runs["algo"] == f"{agent} (relative)"]
             if agent_runs.empty:
@@ -404,19 +408,49 @@ def paper_scale_block(table: pd.DataFrame) -> str:
             cells = [
                 interval_cell(agent_runs["return"].to_numpy(), 0),
                 interval_cell(agent_runs["task_return"].to_numpy(), 0),
+                interval_cell(env_area[env_area["algo"] == agent]["return"].to_numpy(), 0),
+                interval_cell(env_early[env_early["algo"] == agent]["return"].to_numpy(), 0),
                 f"{agent_runs['smoothness'].mean():.4f}",
                 f"{relative['smoothness'].mean():.4f}" if len(relative) else "-",
-                interval_cell(env_early[env_early["algo"] == agent]["return"].to_numpy(), 0),
             ]
             lines.append(f"| {task} | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
-        for agent, baseline, when in PAPER_SCALE_COMPARISONS:
-            source = env_early if when == "early" else runs
+        for agent, baseline, reading in PAPER_SCALE_COMPARISONS:
+            names = f"{PAPER_SCALE_AGENTS[agent]} - {PAPER_SCALE_AGENTS[baseline]}"
+            source = env_early if reading == "early" else runs
             values = [source[source["algo"] == name]["return"].to_numpy() for name in (agent, baseline)]
-            if all(len(value) for value in values):
-                reading = "first-quarter return" if when == "early" else "final return"
-                names = f"{PAPER_SCALE_AGENTS[agent]} - {PAPER_SCALE_AGENTS[baseline]}"
-                readings.append(f"- {task}, {reading}, {names}: {difference_cell(*values)}")
+            if not all(len(value) for value in values):
+                continue
+            if reading == "early":
+                readings.append(f"- {task}, first-quarter return, {names}: {difference_cell(*values)}")
+            elif reading == "final":
+                areas = [env_area[env_area["algo"] == name]["return"].to_numpy() for name in (agent, baseline)]
+                readings.append(
+                    f"- {task}, final return, {names}: {difference_cell(*values)}; area under the curve: "
+                    f"{difference_cell(*areas)}"
+                )
+            else:
+                readings.append(f"- {task}, {smoothness_reading(runs, agent, baseline)}")
     return "\n".join(lines + (["", *readings] if readings else []))
+
+
+def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
+    """``agent``'s final SM with its own decoding and the relative one over ``baseline``'s, and the final task returns'
+    difference: matched when its 95 % interval holds 0 (one run a side: when the difference is 0)."""
+    baseline_sm = runs[runs["algo"] == baseline]["smoothness"].mean()
+    ratios = [
+        f"{decoding} {runs[runs['algo'] == name]['smoothness'].mean() / baseline_sm:.2f}x"
+        for decoding, name in (("argmax", agent), ("relative", f"{agent} (relative)"))
+        if (runs["algo"] == name).any()
+    ]
+    task_returns = [runs[runs["algo"] == name]["task_return"].to_numpy() for name in (agent, baseline)]
+    difference, (low, high) = difference_interval(mean_difference, *task_returns)
+    matched = low <= 0 <= high if np.isfinite(low) else difference == 0
+    label = f"{PAPER_SCALE_AGENTS[agent]} over {PAPER_SCALE_AGENTS[baseline]}"
+    return (
+        f"SM, {label}: {', '.join(ratios)}; final task return, {PAPER_SCALE_AGENTS[agent]} - "
+        f"{PAPER_SCALE_AGENTS[baseline]}: {difference_cell(*task_returns)} "
+        f"({'matched' if matched else 'not matched: the SM ratio compares unequal returns'})"
+    )
 
 
 #: the suite tables' early column: the evaluation nearest this fraction of each run's budget (10k of 50k steps), where
@@ -465,6 +499,28 @@ def suite_block(table: pd.DataFrame, agents: dict[str, str]) -> str:
     return "\n".join(lines)
 
 
+#: the figures a results page links, by file name prefix (plot_suite's names): their alternative text, in page order
+FIGURE_KINDS = {"learning_curves": "learning curves", "aggregate_iqm": "IQM across tasks", "smoothness_radar": "smoothness"}
+
+
+def figures_block(figures: list[Path], page_folder: Path) -> str:
+    """A Markdown image per figure of :data:`FIGURE_KINDS` (others are left out), linked relative to the page's folder:
+    the learning curves first, then the IQM, then the radars, each kind by file name."""
+
+    def kind(figure: Path) -> str | None:
+        return next((prefix for prefix in FIGURE_KINDS if figure.stem.startswith(prefix)), None)
+
+    shown = [figure for figure in figures if kind(figure) is not None]
+    shown.sort(key=lambda figure: (list(FIGURE_KINDS).index(str(kind(figure))), figure.name))
+    images = []
+    for figure in shown:
+        prefix = str(kind(figure))
+        task = figure.stem.removeprefix(prefix).strip("_")
+        text = FIGURE_KINDS[prefix] + (f", {task}" if task else "")
+        images.append(f"![{text}]({figure.relative_to(page_folder).as_posix()})")
+    return "\n\n".join(images)
+
+
 def replace_block(path: Path, name: str, body: str) -> None:
     """Rewrite the generated block ``name`` of the Markdown file ``path``."""
     text = path.read_text()
@@ -485,6 +541,8 @@ def run() -> int:
     replace_block(PAGE, "smooth-default", smooth_default_block())
     if (PAPER_SCALE / "results.csv").exists():
         replace_block(RESULTS / "paper-scale.md", "paper-scale", paper_scale_block(load([PAPER_SCALE / "results.csv"])))
+        figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE)
+        replace_block(RESULTS / "paper-scale.md", "paper-scale-figures", figures_block(figures, RESULTS))
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
