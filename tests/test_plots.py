@@ -73,6 +73,23 @@ def test_radar_return_axis_keeps_larger_better_when_returns_are_negative(tmp_pat
     by_label = {line.get_label(): line.get_ydata() for line in axis.get_lines()}
     assert by_label["gqn-linear c=0.1"][0] == 1.0  # the reference is 1 on every axis
     assert by_label["decqn-9 c=0.1"][0] == pytest.approx(1.0 + (-166.0 + 89.0) / 89.0)  # 0.13: worse, smaller
+    assert "no scale" not in " ".join(text.get_text() for text in figures[0].texts)
+
+
+def test_radar_says_why_the_return_axis_is_empty_when_the_reference_scores_zero(tmp_path, monkeypatch):
+    """A reference agent at task return 0 (a task nobody learned) gives R no scale: every R is drawn at 0, and the
+    caption says why rather than leaving an empty axis unexplained."""
+    final = {"task_return": 0.0, "action_penalty": 1.0, "action_magnitude": 0.3, "action_change": 0.1, "smoothness": 0.01}
+    rows = [
+        {"algo": algo, "env": "A", "penalty": 0.5, "seed": 0, "step": 100, **values}
+        for algo, values in (("gqn-adaptive", final), ("decqn-9", {**final, "task_return": 287.0}))
+    ]
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    smoothness_radar(pd.DataFrame(rows), tmp_path)
+    [axis] = figures[0].axes
+    assert all(line.get_ydata()[0] == 0.0 for line in axis.get_lines())
+    assert "the reference's task return is 0" in " ".join(text.get_text() for text in figures[0].texts)
 
 
 def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):

@@ -377,6 +377,8 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         caption = RADAR_CAPTION + (
             f" Ratios above {RADAR_CLIP:g} are drawn at {RADAR_CLIP:g}, their value beside them." if any_clipped else ""
         )
+        if not np.isfinite(return_radius(np.array([1.0]), float(base["task_return"]))).all():
+            caption += " R is drawn at 0 for every agent: the reference's task return is 0, which gives it no scale."
         caption += " " + left_out_note(every_agent, [str(algo) for algo, _ in means.index], "no runs on this env")
         figure.text(0.5, 0.01, textwrap.fill(caption, 140), ha="center", va="bottom", fontsize=7)
         figure.tight_layout(rect=(0, 0.09, 1, 1))
