@@ -507,14 +507,12 @@ def figures_block(figures: list[Path], page_folder: Path) -> str:
     """A Markdown image per figure of :data:`FIGURE_KINDS` (others are left out), linked relative to the page's folder:
     the learning curves first, then the IQM, then the radars, each kind by file name."""
 
-    def kind(figure: Path) -> str | None:
-        return next((prefix for prefix in FIGURE_KINDS if figure.stem.startswith(prefix)), None)
-
-    shown = [figure for figure in figures if kind(figure) is not None]
-    shown.sort(key=lambda figure: (list(FIGURE_KINDS).index(str(kind(figure))), figure.name))
+    order = list(FIGURE_KINDS)
+    kinds = {figure: next((prefix for prefix in order if figure.stem.startswith(prefix)), None) for figure in figures}
+    shown = sorted((figure for figure, prefix in kinds.items() if prefix), key=lambda f: (order.index(str(kinds[f])), f.name))
     images = []
     for figure in shown:
-        prefix = str(kind(figure))
+        prefix = str(kinds[figure])
         task = figure.stem.removeprefix(prefix).strip("_")
         text = FIGURE_KINDS[prefix] + (f", {task}" if task else "")
         images.append(f"![{text}]({figure.relative_to(page_folder).as_posix()})")

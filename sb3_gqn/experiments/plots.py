@@ -377,7 +377,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
         caption = RADAR_CAPTION + (
             f" Ratios above {RADAR_CLIP:g} are drawn at {RADAR_CLIP:g}, their value beside them." if any_clipped else ""
         )
-        if not np.isfinite(return_radius(np.array([1.0]), float(base["task_return"]))).all():
+        if not np.isfinite(base["task_return"]):  # base holds NaN for a zero: return_radius has no scale
             caption += " R is drawn at 0 for every agent: the reference's task return is 0, which gives it no scale."
         caption += " " + left_out_note(every_agent, [str(algo) for algo, _ in means.index], "no runs on this env")
         figure.text(0.5, 0.01, textwrap.fill(caption, 140), ha="center", va="bottom", fontsize=7)
