@@ -395,7 +395,7 @@ def test_the_relative_decoding_table_by_hand(tmp_path, monkeypatch):
     assert len(body) == 4
 
 
-def test_the_paper_scale_table_by_hand():
+def test_the_paper_scale_table_by_hand(monkeypatch):
     """finger-turn_hard, 40k-step runs (the first quarter: the 10k evaluation). GQN's two seeds end at return 100 and
     200 (SM 0.002, 0.004; with the relative decoding 0.001) after -10 and -30 at 10k (and 3 at 20k for seed 0);
     DecQN-9's at 50 and 150 (SM 0.005) after -50 and -70. So GQN 150 [100, 200], first quarter -20 [-30, -10], area
@@ -404,8 +404,9 @@ def test_the_paper_scale_table_by_hand():
     [+20, +60] with each end at probability 1/16 (both means at their extremes), so the 95 % interval is [+20, +60];
     final +50 [-50, +150] alike (100 - 150 and 200 - 50), area +38 [-9, +85] (31 - 40 and 85 - 0). SM over DecQN-9's:
     0.003 / 0.005 = 0.60x, relative 0.001 / 0.005 = 0.20x; the task returns (return + 1) differ as the returns do,
-    an interval that holds 0: matched.
-    DecQN-2 and SAC did not run: no row, no comparison."""
+    an interval that holds 0: matched. With 2 seeds a cell, the first quarter reads "GQN higher" (the interval lies
+    above 0) and the final return and the area "no resolved difference"; with 3 a cell, each says that it is not read
+    yet. DecQN-2 and SAC did not run: no row, no comparison."""
     import pandas as pd
 
     from sb3_gqn.experiments.scores import with_paired_readings
@@ -422,7 +423,9 @@ def test_the_paper_scale_table_by_hand():
     rows += [row("gqn-adaptive", seed, 40_000, 0.0, 0.001, "relative") for seed in (0, 1)]
     rows += [row("decqn-9", seed, step, value) for seed, step, value in [(0, 10_000, -50.0), (0, 40_000, 50.0)]]
     rows += [row("decqn-9", seed, step, value) for seed, step, value in [(1, 10_000, -70.0), (1, 40_000, 150.0)]]
-    body = page.paper_scale_block(with_paired_readings(pd.DataFrame(rows))).splitlines()
+    table = with_paired_readings(pd.DataFrame(rows))
+    monkeypatch.setattr(page, "PAPER_SCALE_SEEDS", 2)
+    body = page.paper_scale_block(table).splitlines()
     assert body[2] == (
         "| finger-turn_hard | GQN | 2 | 150 [100, 200] | 151 [101, 201] | 58 [31, 85] | -20 [-30, -10] | 0.0030 | 0.0010 |"
     )
@@ -431,11 +434,32 @@ def test_the_paper_scale_table_by_hand():
     )
     assert body[4:] == [
         "",
-        "- finger-turn_hard, first-quarter return, GQN - DecQN-9: +40 [+20, +60]",
-        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150]; area under the curve: +38 [-9, +85]",
+        "- finger-turn_hard, first-quarter return, GQN - DecQN-9: +40 [+20, +60] (GQN higher)",
+        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150] (no resolved difference); area under the "
+        "curve: +38 [-9, +85] (no resolved difference)",
         "- finger-turn_hard, SM, GQN over DecQN-9: argmax 0.60x, relative 0.20x; final task return, GQN - DecQN-9: "
         "+50 [-50, +150] (matched)",
     ]
+    monkeypatch.setattr(page, "PAPER_SCALE_SEEDS", 3)
+    assert page.paper_scale_block(table).splitlines()[5:] == [
+        "- finger-turn_hard, first-quarter return, GQN - DecQN-9: +40 [+20, +60] (not read yet: 2 and 2 of 3 seeds)",
+        "- finger-turn_hard, final return, GQN - DecQN-9: +50 [-50, +150] (not read yet: 2 and 2 of 3 seeds); area "
+        "under the curve: +38 [-9, +85] (not read yet: 2 and 2 of 3 seeds)",
+        "- finger-turn_hard, SM, GQN over DecQN-9: argmax 0.60x, relative 0.20x; final task return, GQN - DecQN-9: "
+        "+50 [-50, +150] (matched) (not read yet: 2 and 2 of 3 seeds)",
+    ]
+
+
+def test_a_paper_scale_difference_below_0_reads_for_the_baseline_and_shows_its_side_of_0():
+    """GQN's runs at 10 and 20 against DecQN-9's at 40 and 50: the replicates' means are 10, 15 or 20 against 40, 45
+    or 50, so the difference -30 has the interval [-40, -20] (each end at probability 1/16), below 0: DecQN-9 higher.
+    A bound that rounds to 0 keeps its sign and two digits: -0.29 is below 0, +0.5 above it, 0 is +0."""
+    import numpy as np
+
+    page = results_page()
+    gqn, decqn = np.array([10.0, 20.0]), np.array([40.0, 50.0])
+    assert page.resolved([gqn, decqn], "gqn-adaptive", "decqn-9", None) == "-30 [-40, -20] (DecQN-9 higher)"
+    assert [page.signed(value) for value in (-0.294, 0.5, 0.0, -1.4, 12.6)] == ["-0.29", "+0.5", "+0", "-1", "+13"]
 
 
 def test_the_figures_block_links_each_known_figure_in_page_order(tmp_path):

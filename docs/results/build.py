@@ -248,10 +248,16 @@ def interval_cell(values: np.ndarray, digits: int) -> str:
     return f"{mean:.{digits}f}" + (f" [{low:.{digits}f}, {high:.{digits}f}]" if len(values) > 1 else "")
 
 
+def signed(value: float) -> str:
+    """``value`` with its sign and no decimals; below 1 in size, two significant digits, so that a bound near 0 shows
+    which side of 0 it lies on (``-0.29``, not ``-0``)."""
+    return f"{value:+.2g}" if 0 < abs(value) < 1 else f"{value:+.0f}"
+
+
 def difference_cell(values_x: np.ndarray, values_y: np.ndarray) -> str:
     """``+d [+low, +high]``: the difference of the means and its 95 % bootstrap interval (none with one run a side)."""
     difference, (low, high) = difference_interval(mean_difference, values_x, values_y)
-    return f"{difference:+.0f}" + (f" [{low:+.0f}, {high:+.0f}]" if np.isfinite(low) else "")
+    return signed(difference) + (f" [{signed(low)}, {signed(high)}]" if np.isfinite(low) else "")
 
 
 def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) -> str:
@@ -308,11 +314,13 @@ def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) 
 
 
 #: The paper-scale runs (paper-scale.md): folder, agents (runner name: label), the first quarter's share of a budget and
-#: the plan's comparisons (GQN, baseline, "early" or "final")
+#: the plan's comparisons (GQN, baseline, "early", "final" or "smoothness")
 PAPER_SCALE = Path(_CHOICES["paper_scale"]["folder"])
 PAPER_SCALE_AGENTS: dict[str, str] = _CHOICES["paper_scale"]["agents"]
 PAPER_SCALE_EARLY = float(_CHOICES["paper_scale"]["early_fraction"])
 PAPER_SCALE_COMPARISONS: list[tuple[str, str, str]] = [tuple(item) for item in _CHOICES["paper_scale"]["comparisons"]]
+#: the plan's seeds per cell: a comparison is read once both of its cells have them all
+PAPER_SCALE_SEEDS = int(_CHOICES["paper_scale"]["seeds"])
 
 
 def sac_smoothness() -> dict[str, float]:
@@ -390,8 +398,9 @@ def paper_scale_block(table: pd.DataFrame) -> str:
     first quarter of the budget (each mean [95 % interval] over seeds), SM with its own decoding and with the paired
     one (GQN and DecQN: argmax and relative); then the plan's comparisons (:data:`PAPER_SCALE_COMPARISONS`) that both
     agents ran: ``early`` and ``final`` as differences of means [95 % interval] (``final`` with the area's beside it),
-    ``smoothness`` as the agent's SM with each decoding over the baseline's, with the final task returns' difference
-    and whether it matches (its interval holds 0)."""
+    each with its reading (:func:`resolved`), ``smoothness`` as the agent's SM with each decoding over the baseline's,
+    with the final task returns' difference and whether it matches (its interval holds 0). A comparison whose cells
+    lack some of :data:`PAPER_SCALE_SEEDS` says so in place of its reading."""
     final, early, area = final_rows(table), early_means(table, PAPER_SCALE_EARLY), early_means(table, 1.0)
     lines = [
         "| task | agent | seeds | return | task return | area under the curve | first-quarter return | SM | SM, relative |",
@@ -420,17 +429,36 @@ def paper_scale_block(table: pd.DataFrame) -> str:
             values = [source[source["algo"] == name]["return"].to_numpy() for name in (agent, baseline)]
             if not all(len(value) for value in values):
                 continue
+            seeds = [len(runs[runs["algo"] == name]) for name in (agent, baseline)]
+            pending = (
+                f"not read yet: {seeds[0]} and {seeds[1]} of {PAPER_SCALE_SEEDS} seeds"
+                if min(seeds) < PAPER_SCALE_SEEDS
+                else None
+            )
             if reading == "early":
-                readings.append(f"- {task}, first-quarter return, {names}: {difference_cell(*values)}")
+                readings.append(f"- {task}, first-quarter return, {names}: {resolved(values, agent, baseline, pending)}")
             elif reading == "final":
                 areas = [env_area[env_area["algo"] == name]["return"].to_numpy() for name in (agent, baseline)]
                 readings.append(
-                    f"- {task}, final return, {names}: {difference_cell(*values)}; area under the curve: "
-                    f"{difference_cell(*areas)}"
+                    f"- {task}, final return, {names}: {resolved(values, agent, baseline, pending)}; area under the "
+                    f"curve: {resolved(areas, agent, baseline, pending)}"
                 )
             else:
-                readings.append(f"- {task}, {smoothness_reading(runs, agent, baseline)}")
+                suffix = f" ({pending})" if pending else ""
+                readings.append(f"- {task}, {smoothness_reading(runs, agent, baseline)}{suffix}")
     return "\n".join(lines + (["", *readings] if readings else []))
+
+
+def resolved(values: list[np.ndarray], agent: str, baseline: str, pending: str | None) -> str:
+    """:func:`difference_cell` of ``agent``'s runs minus ``baseline``'s (``values``: the two, in that order) with the
+    plan's reading of it: the agent with the higher mean where the 95 % interval excludes 0, otherwise "no resolved
+    difference"; ``pending`` (why the comparison is not read yet) in its place while a cell lacks seeds."""
+    values_x, values_y = values
+    _, (low, high) = difference_interval(mean_difference, values_x, values_y)
+    if pending is None:
+        higher = agent if low > 0 else baseline if high < 0 else None
+        pending = f"{PAPER_SCALE_AGENTS[higher]} higher" if higher else "no resolved difference"
+    return f"{difference_cell(values_x, values_y)} ({pending})"
 
 
 def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
