@@ -254,10 +254,15 @@ def signed(value: float) -> str:
     return f"{value:+.2g}" if 0 < abs(value) < 1 else f"{value:+.0f}"
 
 
+def difference_text(difference: float, low: float, high: float) -> str:
+    """``+d [+low, +high]`` (no interval where ``low`` is NaN: one run a side)."""
+    return signed(difference) + (f" [{signed(low)}, {signed(high)}]" if np.isfinite(low) else "")
+
+
 def difference_cell(values_x: np.ndarray, values_y: np.ndarray) -> str:
     """``+d [+low, +high]``: the difference of the means and its 95 % bootstrap interval (none with one run a side)."""
     difference, (low, high) = difference_interval(mean_difference, values_x, values_y)
-    return signed(difference) + (f" [{signed(low)}, {signed(high)}]" if np.isfinite(low) else "")
+    return difference_text(difference, low, high)
 
 
 def smooth_control_block(comparison: pd.DataFrame, path: Path = SMOOTH_CONTROL) -> str:
@@ -453,12 +458,10 @@ def resolved(values: list[np.ndarray], agent: str, baseline: str, pending: str |
     """:func:`difference_cell` of ``agent``'s runs minus ``baseline``'s (``values``: the two, in that order) with the
     plan's reading of it: the agent with the higher mean where the 95 % interval excludes 0, otherwise "no resolved
     difference"; ``pending`` (why the comparison is not read yet) in its place while a cell lacks seeds."""
-    values_x, values_y = values
-    _, (low, high) = difference_interval(mean_difference, values_x, values_y)
-    if pending is None:
-        higher = agent if low > 0 else baseline if high < 0 else None
-        pending = f"{PAPER_SCALE_AGENTS[higher]} higher" if higher else "no resolved difference"
-    return f"{difference_cell(values_x, values_y)} ({pending})"
+    difference, (low, high) = difference_interval(mean_difference, values[0], values[1])
+    higher = agent if low > 0 else baseline if high < 0 else None
+    reading = pending or (f"{PAPER_SCALE_AGENTS[higher]} higher" if higher else "no resolved difference")
+    return f"{difference_text(difference, low, high)} ({reading})"
 
 
 def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
@@ -476,7 +479,7 @@ def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
     label = f"{PAPER_SCALE_AGENTS[agent]} over {PAPER_SCALE_AGENTS[baseline]}"
     return (
         f"SM, {label}: {', '.join(ratios)}; final task return, {PAPER_SCALE_AGENTS[agent]} - "
-        f"{PAPER_SCALE_AGENTS[baseline]}: {difference_cell(*task_returns)} "
+        f"{PAPER_SCALE_AGENTS[baseline]}: {difference_text(difference, low, high)} "
         f"({'matched' if matched else 'not matched: the SM ratio compares unequal returns'})"
     )
 
