@@ -271,3 +271,27 @@ def test_a_success_panel_where_the_agents_coincide_at_a_bound_says_so(tmp_path, 
     success_panel = drawn[0][1][2]
     assert [text.get_text() for text in success_panel.texts] == [message]
     assert [line.get_linewidth() for line in success_panel.lines] == [2.5, 1.5]  # the second stays visible on the first
+
+
+def test_a_wrapped_left_out_note_stays_clear_of_the_legend(tmp_path, monkeypatch):
+    # task A has one agent of six: the note names five with their reasons and wraps onto two lines
+    agents = ["gqn-adaptive", "gqn-adaptive (relative)", "decqn-2", "decqn-2 (relative)", "decqn-9", "decqn-9 (relative)"]
+    rows = [
+        {"algo": algo, "env": env, "penalty": 0.5, "seed": seed, "step": step, "return": 1.0 + seed,
+         "wall_time": step / 10, "growth_events": ""}
+        for env, drawn in (("A", agents[:1]), ("B", agents))
+        for algo in drawn
+        for seed in (0, 1)
+        for step in (100, 200)
+    ]  # fmt: skip
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    plots.learning_curves(pd.DataFrame(rows), tmp_path)
+    figure = figures[0]
+    [note] = [text for text in figure.texts if text.get_text().startswith("Left out")]
+    assert note.get_text().count("\n") == 1
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    [legend] = figure.legends
+    assert not legend.get_window_extent(renderer).overlaps(note.get_window_extent(renderer))
+    assert not any(note.get_window_extent(renderer).overlaps(axis.get_window_extent(renderer)) for axis in figure.axes)

@@ -62,6 +62,8 @@ OTHER_COLORS = (
 )  # fmt: skip
 #: line styles that tell apart two agents of one figure whose names chose the same colour
 COLOR_SHARE_DASHES = ("-", "--", ":", "-.")
+#: a line of a figure's 8-point note, as a share of a learning-curve figure's 5-inch height (with line spacing)
+NOTE_LINE_HEIGHT = 0.028
 
 
 def agent_color(agent: str) -> str:
@@ -204,12 +206,13 @@ def learning_curves(table: pd.DataFrame, out: Path, warnings: list[str] | None =
         handles, labels = axes[0].get_legend_handles_labels()
         columns = min(len(labels), 4)
         legend_rows = -(-len(labels) // columns)
-        figure.legend(handles, labels, loc="lower center", ncol=columns, fontsize=8, bbox_to_anchor=(0.5, 0.04))
-        note = left_out_note(every_agent, agents, "no runs on this task")
-        figure.text(0.5, 0.005, textwrap.fill(note, 150), ha="center", va="bottom", fontsize=8)
+        note = textwrap.fill(left_out_note(every_agent, agents, "no runs on this task"), 150)
+        figure.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=8)
+        legend_bottom = 0.015 + NOTE_LINE_HEIGHT * (note.count("\n") + 1)  # the legend sits on the note, clear of it
+        figure.legend(handles, labels, loc="lower center", ncol=columns, fontsize=8, bbox_to_anchor=(0.5, legend_bottom))
         spread = "mean over seeds, 95 % CI band" if most_seeds > 1 else "one seed"
         figure.suptitle(f"{env}, action penalty c = {penalty:g} ({spread})")
-        figure.tight_layout(rect=(0, 0.08 + 0.045 * legend_rows, 1, 1))
+        figure.tight_layout(rect=(0, legend_bottom + 0.04 + 0.045 * legend_rows, 1, 1))
         path = out / f"learning_curves_{_slug(env)}_c{penalty:g}.png"
         figure.savefig(path, dpi=110)
         plt.close(figure)
