@@ -4,7 +4,8 @@ training as they did.
 The files in ``tests/fixtures/v0.2/`` were written by ``make_fixtures.py`` beside them with 0.2 installed;
 ``expected.npz`` holds what each model did then, and what continuing each checkpoint with its replay buffer did under
 fixed seeds (with the library versions in ``continued.json``: other versions of torch round differently, and then only
-the schedule's course is compared).
+the schedule's course is compared). Continuous values are compared to within a few units in the last place: the
+vectorised ``exp`` and ``pow`` of numpy and torch round differently on different CPU instruction sets.
 """
 
 from __future__ import annotations
@@ -52,6 +53,12 @@ def continued(model: GQN, steps: int) -> GQN:
         th.set_num_threads(threads)
 
 
+def assert_equal_but_for_rounding(actual: np.ndarray, expected: np.ndarray) -> None:
+    """Equal to within 16 units in the last place of ``expected``'s float type (a changed computation moves far more)."""
+    eps = float(np.finfo(expected.dtype).eps)
+    np.testing.assert_allclose(actual, expected, rtol=16 * eps, atol=16 * eps)
+
+
 def actions(model: GQN) -> np.ndarray:
     return model.predict(OBSERVATIONS, deterministic=True)[0]
 
@@ -97,7 +104,7 @@ def test_an_adaptive_checkpoint_continues_with_its_replay_buffer():
     if SAME_LIBRARIES:
         assert events(model) == expected_events("adaptive_continued_events")
         np.testing.assert_array_equal(actions(model), EXPECTED["adaptive_continued_actions"])
-        np.testing.assert_array_equal(model.replay_buffer.priorities.leaves, EXPECTED["adaptive_continued_priorities"])
+        assert_equal_but_for_rounding(model.replay_buffer.priorities.leaves, EXPECTED["adaptive_continued_priorities"])
 
 
 @pytest.mark.parametrize("algo", [DecQN, GQN])
@@ -116,13 +123,13 @@ def test_a_prioritized_checkpoint_keeps_its_priority_settings_and_priorities(alg
     assert model.replay_buffer.beta == EXPECTED["prioritized_continued_beta"] == 1.0
     if SAME_LIBRARIES:
         np.testing.assert_array_equal(actions(model), EXPECTED["prioritized_continued_actions"])
-        np.testing.assert_array_equal(model.replay_buffer.priorities.leaves, EXPECTED["prioritized_continued_priorities"])
+        assert_equal_but_for_rounding(model.replay_buffer.priorities.leaves, EXPECTED["prioritized_continued_priorities"])
 
 
 def test_an_expectation_decoding_model_acts_at_its_temperature():
     model = GQN.load(FIXTURES / "gqn_expectation.zip", env=short_pendulum())
     assert (model.decoding, model.softmax_temperature, model.exploration) == ("expectation", 0.5, "per_dimension")
-    np.testing.assert_array_equal(actions(model), EXPECTED["expectation_actions"])
+    assert_equal_but_for_rounding(actions(model), EXPECTED["expectation_actions"])
     np.testing.assert_array_equal(model.policy.predict(OBSERVATIONS)[0], EXPECTED["expectation_argmax_actions"])
 
 
@@ -152,7 +159,7 @@ def test_a_0_2_model_saved_again_loads_as_it_was(tmp_path, name, algo, key):
     model = algo.load(FIXTURES / f"{name}.zip", env=short_pendulum())
     model.save(tmp_path / "again.zip")
     again = algo.load(tmp_path / "again.zip", env=short_pendulum())
-    np.testing.assert_array_equal(actions(again), EXPECTED[f"{key}_actions"])
+    assert_equal_but_for_rounding(actions(again), EXPECTED[f"{key}_actions"])
     assert (again.growth, again.growth_level, again.growth_init) == (model.growth, model.growth_level, model.growth_init)
     if model.growth_schedule is None:
         assert again.growth_schedule is None
