@@ -210,6 +210,17 @@ def trained(algo: str, env: str, variants) -> dict:
     return {**shipped_entry(zoo_algo, env), **overrides}
 
 
+def test_humanoid_probes_train_gqns_humanoid_entry_changed_in_one_setting_each(research_variants):
+    humanoid = "dm_control/humanoid-stand-v0"
+    defaults = trained("gqn-adaptive", humanoid, research_variants)
+    for name, change in {
+        "gqn-adaptive+torso2048": {"policy_kwargs": "dict(net_arch=[2048, 2048])"},
+        "gqn-adaptive+2updates": {"gradient_steps": 2},
+    }.items():
+        probe = trained(name, humanoid, research_variants)
+        assert {key: value for key, value in probe.items() if defaults.get(key) != value} == change
+
+
 def results_page():
     """docs/results/build.py (a script, not a module of the package)."""
     spec = importlib.util.spec_from_file_location("results_page", Path(__file__).parents[1] / "docs/results/build.py")
