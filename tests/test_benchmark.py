@@ -360,6 +360,10 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
         ]
         # curves and a radar per task, one IQM
         assert all(figure.exists() for figure in figures) and len(figures) == 2 * paper_scale["env"].nunique() + 1
+        probes = Path(page.PROBES["folder"]) / "results.csv"
+        assert block(page.RESULTS / "paper-scale.md", "paper-scale-probes") == page.probes_block(
+            page.load([probes]) if probes.exists() else None, paper_scale
+        )
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
             suite_table = page.load([path / "results.csv"])
@@ -504,6 +508,49 @@ def test_the_paper_scale_smoothness_reading_says_when_returns_differ():
     assert page.smoothness_reading(runs, "gqn-adaptive", "sbx-sac") == (
         "SM, GQN over SAC (SBX): argmax 0.50x; final task return, GQN - SAC (SBX): -190 [-200, -180] "
         "(not matched: the SM ratio compares unequal returns)"
+    )
+
+
+def test_the_humanoid_probes_table_by_hand():
+    """Budget 30k, bar 50. The plan's seed 0 scores task return 5, 6 and 7 at 10k-30k (and 200 at 40k, past the
+    budget): final 7, highest 7, never above 50: does not stand. The penalty probe scores 5, 80 and 30: highest 80,
+    first above 50 at 20k, final 30: rises. The update-ratio probe scores 40, 45 and 60 (its relative reading 500 is
+    not the argmax): final 60: stands. Seed 1 and c = 0.5 runs of the penalty probe's agent are other runs. The
+    capacity probe has not run; with it at 10, 20 and 30 no probe moves but the two that did."""
+    import pandas as pd
+
+    page = results_page()
+    choices = {**page.PROBES, "steps": 30_000}
+    env = choices["env"]
+
+    def evaluations(algo, penalty, task_returns, seed=0, steps=(10_000, 20_000, 30_000)):
+        return [{"algo": algo, "env": env, "penalty": penalty, "seed": seed, "step": step, "return": value - 100.0,
+                 "task_return": value, "action_magnitude": 0.25} for step, value in zip(steps, task_returns)]  # fmt: skip
+
+    plan = pd.DataFrame(evaluations("gqn-adaptive", 0.5, [5.0, 6.0, 7.0, 200.0], steps=(10_000, 20_000, 30_000, 40_000)))
+    probes = evaluations("gqn-adaptive", 0.1, [5.0, 80.0, 30.0]) + evaluations("gqn-adaptive", 0.1, [99.0] * 3, seed=1)
+    probes += evaluations("gqn-adaptive", 0.5, [99.0] * 3) + evaluations("gqn-adaptive+2updates", 0.5, [40.0, 45.0, 60.0])
+    probes += evaluations("gqn-adaptive+2updates (relative)", 0.5, [500.0] * 3)
+    body = page.probes_block(pd.DataFrame(probes), plan, choices).splitlines()
+    labels = [choices["reference"]["label"], *(entry["label"] for entry in choices["runs"])]
+    assert body[2:6] == [
+        f"| {labels[0]} | 30k | 7 | 7 | - | -93 | 0.25 | does not stand |",
+        f"| {labels[1]} | 30k | 30 | 80 | 20k | -70 | 0.25 | rises |",
+        f"| {labels[2]} | - | - | - | - | - | - | not run yet |",
+        f"| {labels[3]} | 30k | 60 | 60 | 30k | -40 | 0.25 | stands |",
+    ]
+    read = f"Stands or rises: {labels[1]} (rises); {labels[3]} (stands)."
+    assert body[-1].startswith(read)
+    probes += evaluations("gqn-adaptive+torso2048", 0.5, [10.0, 20.0, 30.0])
+    assert page.probes_block(pd.DataFrame(probes), plan, choices).splitlines()[-1].startswith(read)
+    nothing_moves = [run for run in probes if run["algo"] == "gqn-adaptive+torso2048"]
+    nothing_moves += [{**run, "task_return": 10.0} for run in probes if run["algo"] != "gqn-adaptive+torso2048"]
+    assert page.probes_block(pd.DataFrame(nothing_moves), plan, choices).splitlines()[-1] == (
+        "No probe stands or rises: the probes do not point to the penalty, the capacity or the update ratio within 30k "
+        "steps. What remains is the budget."
+    )
+    assert page.probes_block(None, plan, choices).splitlines()[-1] == (
+        "Not read yet: 0 of 3 probes have finished, and none stands or rises."
     )
 
 

@@ -326,6 +326,9 @@ PAPER_SCALE_EARLY = float(_CHOICES["paper_scale"]["early_fraction"])
 PAPER_SCALE_COMPARISONS: list[tuple[str, str, str]] = [tuple(item) for item in _CHOICES["paper_scale"]["comparisons"]]
 #: the plan's seeds per cell: a comparison is read once both of its cells have them all
 PAPER_SCALE_SEEDS = int(_CHOICES["paper_scale"]["seeds"])
+#: The humanoid probes: their runner folder, task, seed and budget, the bar a final task return must pass to stand, the
+#: plan's run they are read against and the probes themselves (each: algo, penalty, label)
+PROBES: dict = _CHOICES["paper_scale"]["probes"]
 
 
 def sac_smoothness() -> dict[str, float]:
@@ -484,6 +487,70 @@ def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
     )
 
 
+def probe_row(runs: pd.DataFrame, label: str, steps: int, bar: float) -> tuple[str, str | None]:
+    """One row of :func:`probes_block` from one run's evaluations up to ``steps`` (argmax readings; none: the run has
+    not finished): its last step, final and highest task return, the first evaluation above ``bar``, final return,
+    mean |a| and the reading, which it returns beside the row (None before the run has finished)."""
+    runs = runs[runs["step"] <= steps].sort_values("step")
+    if runs.empty:
+        return f"| {label} | - | - | - | - | - | - | not run yet |", None
+    final = runs.iloc[-1]
+    above = runs[runs["task_return"] > bar]
+    reading = "stands" if final["task_return"] > bar else "rises" if len(above) else "does not stand"
+    cells = [
+        f"{final['step'] / 1000:g}k",
+        f"{final['task_return']:.0f}",
+        f"{runs['task_return'].max():.0f}",
+        f"{above['step'].iloc[0] / 1000:g}k" if len(above) else "-",
+        f"{final['return']:.0f}",
+        f"{final['action_magnitude']:.2f}",
+        reading,
+    ]
+    return f"| {label} | " + " | ".join(cells) + " |", reading
+
+
+def probes_block(probes: pd.DataFrame | None, plan: pd.DataFrame, choices: Mapping = PROBES) -> str:
+    """The humanoid probes (``probes``: their runner folder's table, None before one has finished) and the plan's run
+    they are read against (from ``plan``), one row each over the probes' budget (:func:`probe_row`), then what they
+    point to: the probes that stand or rise, or, once all have run and none does, that they point to none of their
+    settings."""
+    env, seed, steps, bar = choices["env"], int(choices["seed"]), int(choices["steps"]), float(choices["stands_above"])
+    lines = [
+        f"| run | steps | final task return | highest task return | first above {bar:g} | final return | final mean abs(a) "
+        "| reading |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+
+    def runs_of(table: pd.DataFrame | None, entry: Mapping) -> pd.DataFrame:
+        if table is None:
+            return plan.iloc[0:0]
+        chosen = (table["algo"] == entry["algo"]) & (table["env"] == env) & (table["seed"] == seed)
+        return table[chosen & np.isclose(table["penalty"], float(entry["penalty"]))]
+
+    reference = choices["reference"]
+    lines.append(probe_row(runs_of(plan, reference), reference["label"], steps, bar)[0])
+    readings = {}
+    for entry in choices["runs"]:
+        row, reading = probe_row(runs_of(probes, entry), entry["label"], steps, bar)
+        lines.append(row)
+        if reading:
+            readings[entry["label"]] = reading
+    moved = [f"{label} ({reading})" for label, reading in readings.items() if reading != "does not stand"]
+    if moved:
+        summary = (
+            f"Stands or rises: {'; '.join(moved)}. The plan reads each as a setting that holds GQN back on this task at "
+            "this budget."
+        )
+    elif len(readings) < len(choices["runs"]):
+        summary = f"Not read yet: {len(readings)} of {len(choices['runs'])} probes have finished, and none stands or rises."
+    else:
+        summary = (
+            "No probe stands or rises: the probes do not point to the penalty, the capacity or the update ratio within "
+            f"{steps / 1000:g}k steps. What remains is the budget."
+        )
+    return "\n".join([*lines, "", summary])
+
+
 #: the suite tables' early column: the evaluation nearest this fraction of each run's budget (10k of 50k steps), where
 #: the paper expects growth from 2 bins to start poorly on velocity control
 EARLY_FRACTION = 0.2
@@ -569,9 +636,14 @@ def run() -> int:
         replace_block(PAGE, "smooth-control", smooth_control_block(table))
     replace_block(PAGE, "smooth-default", smooth_default_block())
     if (PAPER_SCALE / "results.csv").exists():
-        replace_block(RESULTS / "paper-scale.md", "paper-scale", paper_scale_block(load([PAPER_SCALE / "results.csv"])))
+        plan = load([PAPER_SCALE / "results.csv"])
+        replace_block(RESULTS / "paper-scale.md", "paper-scale", paper_scale_block(plan))
         figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE)
         replace_block(RESULTS / "paper-scale.md", "paper-scale-figures", figures_block(figures, RESULTS))
+        probes = Path(PROBES["folder"]) / "results.csv"
+        replace_block(
+            RESULTS / "paper-scale.md", "paper-scale-probes", probes_block(load([probes]) if probes.exists() else None, plan)
+        )
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
