@@ -550,7 +550,7 @@ def test_the_humanoid_probes_table_by_hand():
         "steps. What remains is the budget."
     )
     assert page.probes_block(None, plan, choices).splitlines()[-1] == (
-        "Not read yet: 0 of 3 probes have finished, and none stands or rises."
+        "Not read yet: 0 of 3 probes finished; none stands or rises."
     )
 
 

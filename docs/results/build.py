@@ -542,7 +542,7 @@ def probes_block(probes: pd.DataFrame | None, plan: pd.DataFrame, choices: Mappi
             "this budget."
         )
     elif len(readings) < len(choices["runs"]):
-        summary = f"Not read yet: {len(readings)} of {len(choices['runs'])} probes have finished, and none stands or rises."
+        summary = f"Not read yet: {len(readings)} of {len(choices['runs'])} probes finished; none stands or rises."
     else:
         summary = (
             "No probe stands or rises: the probes do not point to the penalty, the capacity or the update ratio within "
