@@ -360,10 +360,8 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
         ]
         # curves and a radar per task, one IQM
         assert all(figure.exists() for figure in figures) and len(figures) == 2 * paper_scale["env"].nunique() + 1
-        probes = Path(page.PROBES["folder"]) / "results.csv"
-        assert block(page.RESULTS / "paper-scale.md", "paper-scale-probes") == page.probes_block(
-            page.load([probes]) if probes.exists() else None, paper_scale
-        )
+        probes = page.probes_block(page.probe_runs(), paper_scale)
+        assert block(page.RESULTS / "paper-scale.md", "paper-scale-probes") == probes
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
             suite_table = page.load([path / "results.csv"])

@@ -509,6 +509,11 @@ def probe_row(runs: pd.DataFrame, label: str, steps: int, bar: float) -> tuple[s
     return f"| {label} | " + " | ".join(cells) + " |", reading
 
 
+def probe_runs(path: Path = Path(PROBES["folder"])) -> pd.DataFrame | None:
+    """Every evaluation of the humanoid probes' runs (None before one has finished)."""
+    return load([path / "results.csv"]) if (path / "results.csv").exists() else None
+
+
 def probes_block(probes: pd.DataFrame | None, plan: pd.DataFrame, choices: Mapping = PROBES) -> str:
     """The humanoid probes (``probes``: their runner folder's table, None before one has finished) and the plan's run
     they are read against (from ``plan``), one row each over the probes' budget (:func:`probe_row`), then what they
@@ -640,10 +645,7 @@ def run() -> int:
         replace_block(RESULTS / "paper-scale.md", "paper-scale", paper_scale_block(plan))
         figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE)
         replace_block(RESULTS / "paper-scale.md", "paper-scale-figures", figures_block(figures, RESULTS))
-        probes = Path(PROBES["folder"]) / "results.csv"
-        replace_block(
-            RESULTS / "paper-scale.md", "paper-scale-probes", probes_block(load([probes]) if probes.exists() else None, plan)
-        )
+        replace_block(RESULTS / "paper-scale.md", "paper-scale-probes", probes_block(probe_runs(), plan))
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     replace_block(README, "development", development_block())
