@@ -8,6 +8,7 @@ import importlib.util
 import json
 import re
 import shutil
+import sys
 import threading
 import time
 from pathlib import Path
@@ -221,12 +222,28 @@ def test_humanoid_probes_train_gqns_humanoid_entry_changed_in_one_setting_each(r
         assert {key: value for key, value in probe.items() if defaults.get(key) != value} == change
 
 
-def results_page():
-    """docs/results/build.py (a script, not a module of the package)."""
-    spec = importlib.util.spec_from_file_location("results_page", Path(__file__).parents[1] / "docs/results/build.py")
+RESULTS_SCRIPTS = Path(__file__).parents[1] / "docs" / "results"
+
+
+def results_script(name):
+    """docs/results/<name>.py, loaded afresh: the results pages' scripts (not modules of the package), which import each
+    other by name as they do when make results-page runs build.py."""
+    if str(RESULTS_SCRIPTS) not in sys.path:
+        sys.path.insert(0, str(RESULTS_SCRIPTS))
+    spec = importlib.util.spec_from_file_location(f"results_{name}", RESULTS_SCRIPTS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def results_page():
+    """docs/results/build.py: the results page, the README's blocks and the suite pages."""
+    return results_script("build")
+
+
+def paper_scale_page():
+    """docs/results/paper_scale_blocks.py: the paper-scale page's blocks."""
+    return results_script("paper_scale_blocks")
 
 
 def test_walker_and_finger_runs_of_the_shipped_entries_are_their_1update_torso_variants(research_variants):
@@ -351,16 +368,17 @@ def test_the_generated_blocks_match_the_committed_tables(monkeypatch):
     if len(page.smooth_control_runs()):
         assert block(page.PAGE, "smooth-control") == page.smooth_control_block(table)
     assert block(page.PAGE, "smooth-default") == page.smooth_default_block()
-    if (page.PAPER_SCALE / "results.csv").exists():
-        paper_scale = page.load([page.PAPER_SCALE / "results.csv"])
-        assert block(page.RESULTS / "paper-scale.md", "paper-scale") == page.paper_scale_block(paper_scale)
+    paper = paper_scale_page()
+    if (paper.PAPER_SCALE / "results.csv").exists():
+        paper_scale = page.load([paper.PAPER_SCALE / "results.csv"])
+        assert block(page.RESULTS / "paper-scale.md", "paper-scale") == paper.paper_scale_block(paper_scale)
         figures = [
             page.RESULTS / link.split("](")[1].rstrip(")")
             for link in block(page.RESULTS / "paper-scale.md", "paper-scale-figures").split("\n\n")
         ]
         # curves and a radar per task, one IQM
         assert all(figure.exists() for figure in figures) and len(figures) == 2 * paper_scale["env"].nunique() + 1
-        probes = page.probes_block(page.probe_runs(), paper_scale)
+        probes = paper.probes_block(paper.probe_runs(), paper_scale)
         assert block(page.RESULTS / "paper-scale.md", "paper-scale-probes") == probes
     for name, (path, agents) in page.SUITES.items():
         if (path / "results.csv").exists():
@@ -424,7 +442,7 @@ def test_the_paper_scale_table_by_hand(monkeypatch):
 
     from sb3_gqn.experiments.scores import with_paired_readings
 
-    page = results_page()
+    page = paper_scale_page()
 
     def row(algo, seed, step, value, sm=0.005, decoding=""):
         return {"algo": algo, "env": "dm_control/finger-turn_hard-v0", "penalty": 0.5, "seed": seed, "step": step,
@@ -469,15 +487,16 @@ def test_a_paper_scale_difference_below_0_reads_for_the_baseline_and_shows_its_s
     A bound that rounds to 0 keeps its sign and two digits: -0.29 is below 0, +0.5 above it, 0 is +0."""
     import numpy as np
 
-    page = results_page()
+    page = paper_scale_page()
     gqn, decqn = np.array([10.0, 20.0]), np.array([40.0, 50.0])
     assert page.resolved([gqn, decqn], "gqn-adaptive", "decqn-9", None) == "-30 [-40, -20] (DecQN-9 higher)"
-    assert [page.signed(value) for value in (-0.294, 0.5, 0.0, -1.4, 12.6)] == ["-0.29", "+0.5", "+0", "-1", "+13"]
+    signed = results_script("page_cells").signed
+    assert [signed(value) for value in (-0.294, 0.5, 0.0, -1.4, 12.6)] == ["-0.29", "+0.5", "+0", "-1", "+13"]
 
 
 def test_the_figures_block_links_each_known_figure_in_page_order(tmp_path):
     """Curves first, then the IQM, then the radars, each kind by name; a figure of another kind is not linked."""
-    page = results_page()
+    page = results_script("page_cells")
     folder = tmp_path / "suite"
     names = ["smoothness_radar_b.png", "aggregate_iqm.png", "learning_curves_b_c0.5.png", "learning_curves_a_c0.5.png"]
     body = page.figures_block([folder / name for name in [*names, "q_values_a.png"]], tmp_path)
@@ -494,7 +513,7 @@ def test_the_paper_scale_smoothness_reading_says_when_returns_differ():
     SAC's, and the task returns differ by -190 [-200, -180], an interval without 0: not matched."""
     import pandas as pd
 
-    page = results_page()
+    page = paper_scale_page()
     runs = pd.DataFrame(
         [
             {"algo": "gqn-adaptive", "seed": 0, "task_return": 100.0, "smoothness": 0.001},
@@ -517,7 +536,7 @@ def test_the_humanoid_probes_table_by_hand():
     capacity probe has not run; with it at 10, 20 and 30 no probe moves but the two that did."""
     import pandas as pd
 
-    page = results_page()
+    page = paper_scale_page()
     choices = {**page.PROBES, "steps": 30_000}
     env = choices["env"]
 
