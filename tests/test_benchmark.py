@@ -533,7 +533,7 @@ def test_the_humanoid_probes_table_by_hand():
     budget): final 7, highest 7, never above 50: does not stand. The penalty probe scores 5, 80 and 30: highest 80,
     first above 50 at 20k, final 30: rises. The update-ratio probe scores 40, 45 and 60 (its relative reading 500 is
     not the argmax): final 60: stands. Seed 1 and c = 0.5 runs of the penalty probe's agent are other runs. The
-    capacity probe has not run; with it at 10, 20 and 30 no probe moves but the two that did."""
+    capacity probe has not finished; with it at 10, 20 and 30 no probe moves but the two that did."""
     import pandas as pd
 
     page = paper_scale_page()
@@ -553,7 +553,7 @@ def test_the_humanoid_probes_table_by_hand():
     assert body[2:6] == [
         f"| {labels[0]} | 30k | 7 | 7 | - | -93 | 0.25 | does not stand |",
         f"| {labels[1]} | 30k | 30 | 80 | 20k | -70 | 0.25 | rises |",
-        f"| {labels[2]} | - | - | - | - | - | - | not run yet |",
+        f"| {labels[2]} | - | - | - | - | - | - | not finished |",
         f"| {labels[3]} | 30k | 60 | 60 | 30k | -40 | 0.25 | stands |",
     ]
     read = f"Stands or rises: {labels[1]} (rises); {labels[3]} (stands)."

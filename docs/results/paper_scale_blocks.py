@@ -129,7 +129,7 @@ def probe_row(runs: pd.DataFrame, label: str, steps: int, bar: float) -> tuple[s
     mean |a| and the reading, which it returns beside the row (None before the run has finished)."""
     runs = runs[runs["step"] <= steps].sort_values("step")
     if runs.empty:
-        return f"| {label} | - | - | - | - | - | - | not run yet |", None
+        return f"| {label} | - | - | - | - | - | - | not finished |", None
     final = runs.iloc[-1]
     above = runs[runs["task_return"] > bar]
     reading = "stands" if final["task_return"] > bar else "rises" if len(above) else "does not stand"
