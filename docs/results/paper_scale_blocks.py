@@ -192,14 +192,13 @@ def probes_block(probes: pd.DataFrame | None, plan: pd.DataFrame, choices: Mappi
     return "\n".join([*lines, "", summary])
 
 
-def rebuild(page: Path = RESULTS / "paper-scale.md") -> bool:
+def rebuild(page: Path = RESULTS / "paper-scale.md") -> None:
     """Rewrite ``page``'s blocks (the plan's table and readings, the figures drawn into the runs' folder, the probes)
-    from the committed tables; False, with nothing written, before the plan's first run has finished."""
+    from the committed tables; nothing before the plan's first run has finished."""
     if not (PAPER_SCALE / "results.csv").exists():
-        return False
+        return
     plan = load([PAPER_SCALE / "results.csv"])
     replace_block(page, "paper-scale", paper_scale_block(plan))
     figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE)
     replace_block(page, "paper-scale-figures", figures_block(figures, page.parent))
     replace_block(page, "paper-scale-probes", probes_block(probe_runs(), plan))
-    return True
