@@ -227,13 +227,22 @@ RESULTS_SCRIPTS = Path(__file__).parents[1] / "docs" / "results"
 
 def results_script(name):
     """docs/results/<name>.py, loaded afresh: the results pages' scripts (not modules of the package), which import each
-    other by name as they do when make results-page runs build.py."""
-    if str(RESULTS_SCRIPTS) not in sys.path:
-        sys.path.insert(0, str(RESULTS_SCRIPTS))
-    spec = importlib.util.spec_from_file_location(f"results_{name}", RESULTS_SCRIPTS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    other by name as they do when make results-page runs build.py. docs/results is on sys.path only while the script
+    loads: its result folders (docs/results/myosuite) would otherwise pass for installed packages in later tests."""
+    sys.path.insert(0, str(RESULTS_SCRIPTS))
+    try:
+        spec = importlib.util.spec_from_file_location(f"results_{name}", RESULTS_SCRIPTS / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(RESULTS_SCRIPTS))
     return module
+
+
+def test_loading_a_results_script_leaves_no_result_folder_importable():
+    results_script("build")
+    assert str(RESULTS_SCRIPTS) not in sys.path
+    assert importlib.util.find_spec("myosuite") is None or importlib.util.find_spec("myosuite").origin is not None
 
 
 def results_page():
