@@ -2,6 +2,7 @@
 
 from sb3_gqn.common.envs import register_project_envs
 from sb3_gqn.common.module_aliases import install as _install_module_aliases
+from sb3_gqn.common.presets import paper_preset
 from sb3_gqn.decqn import DecQN
 from sb3_gqn.gqn import GQN
 
@@ -10,4 +11,4 @@ __version__ = "0.3.0"
 _install_module_aliases()  # models and replay buffers saved by 0.1.0 name its flat module paths
 register_project_envs()  # the sb3_gqn/... env ids work wherever sb3_gqn is imported
 
-__all__ = ["GQN", "DecQN", "__version__"]
+__all__ = ["GQN", "DecQN", "__version__", "paper_preset"]

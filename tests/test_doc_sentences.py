@@ -150,8 +150,8 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         "range (the utilities are float32: outside it the temperature is 0 or inf there and the softmax is NaN)": lambda: GQN(
             "MlpPolicy", DecliningEnv(), decoding_kwargs=dict(temperature=1e300)
         ),
-        "growth_kwargs has no setting 'patiense': its keys are ('init', 'eval_freq', 'eval_episodes', 'window', "
-        "'returns_source', 'patience', 'min_improvement', 'probation')": lambda: GQN(
+        "growth_kwargs has no setting 'patiense': its keys are ('init', 'eval_freq', 'eval_fraction', 'eval_episodes', "
+        "'window', 'returns_source', 'patience', 'min_improvement', 'probation')": lambda: GQN(
             "MlpPolicy", DecliningEnv(), growth_kwargs=dict(patiense=3)
         ),
         "replay_buffer_kwargs['alpha'] must be a finite number in [0, inf), got -1": lambda: GQN(

@@ -378,7 +378,8 @@ def test_growth_none_with_a_bins_pair_trains_at_the_first_level():
     ],
 )
 def test_every_growth_and_exploration_option_learns(options):
-    options = {**options, "growth_kwargs": {"eval_freq": 10, **options.get("growth_kwargs", {})}}
+    if options["growth"] == "adaptive":
+        options = {**options, "growth_kwargs": {"eval_freq": 10, **options["growth_kwargs"]}}
     model = GQN("MlpPolicy", DecliningEnv(), **options, **SMALL)
     model.learn(400)
     assert model.num_timesteps == 400 and model._n_updates > 0

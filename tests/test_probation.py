@@ -124,7 +124,7 @@ def test_on_probation_only_exploration_and_probation_episodes_use_the_opened_lev
 def test_on_probation_the_td_target_maximizes_over_the_deployed_level(monkeypatch):
     import sb3_gqn.gqn.gqn as gqn_module
 
-    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(probation=2), **SMALL)
+    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=dict(probation=2, eval_freq=2_500), **SMALL)
     model.learn(150)  # fills the buffer, no growth decision yet (window 3 of 2 500-step evaluations)
     masks = []
     original = gqn_module.critic_ensemble_targets

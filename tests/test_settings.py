@@ -57,7 +57,7 @@ def settings_of(model: GQN) -> dict:
 def test_the_table_covers_every_keyword_and_the_groups_take_their_keys():
     assert set(OLD_VALUES) == set(DEPRECATED_KEYWORDS)
     growth_keys = {key for group, key in DEPRECATED_KEYWORDS.values() if group == "growth_kwargs"}
-    assert growth_keys == {"init", *AdaptiveGrowth.SETTINGS}
+    assert growth_keys == {"init", *AdaptiveGrowth.SETTINGS} - {"eval_fraction"}  # eval_fraction came after 0.2
     buffer_keys = {key for group, key in DEPRECATED_KEYWORDS.values() if group == "replay_buffer_kwargs"}
     assert buffer_keys - {"prioritized"} <= set(inspect.signature(PrioritizedSampling.__init__).parameters)
     assert new_spelling("growth_patience", 3) == "growth_kwargs=dict(patience=3)"
@@ -132,7 +132,7 @@ def test_the_defaults_live_in_one_place():
     page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "modules" / "gqn.rst").read_text().split())
     schedule = AdaptiveGrowth()
     assert (
-        f"``eval_freq`` ({schedule.eval_freq:,}".replace(",", " ") in page
+        f"``eval_fraction`` ({schedule.eval_fraction})" in page
         and f"``window`` ({schedule.window})" in page
         and f"``patience`` ({schedule.patience})" in page
         and f"``alpha`` ({defaults['alpha']})" in page

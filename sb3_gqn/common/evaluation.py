@@ -176,7 +176,8 @@ def decoded_as(model: Any, decoding: str) -> Iterator[Any]:
 
 
 class LearningCurveCallback(BaseCallback):
-    """Evaluates greedily every ``eval_freq`` environment steps and at the end of training.
+    """Evaluates greedily every ``eval_freq`` environment steps and at the end of training (the last evaluation, at the
+    end of ``learn()``'s budget, with ``final_episodes`` episodes).
 
     Each evaluation is a row (kept in :attr:`rows` and handed to ``on_row``): ``step``, ``train_seconds`` (training
     time so far, evaluations excluded), the :class:`~sb3_gqn.common.smoothness.SmoothnessFigures` of the greedy
@@ -185,6 +186,7 @@ class LearningCurveCallback(BaseCallback):
     :param eval_env: a single evaluation env with a ``Box`` action space
     :param eval_freq: environment steps between evaluations
     :param n_episodes: greedy episodes per evaluation
+    :param final_episodes: greedy episodes of the evaluation at the end of training (``None``: ``n_episodes``)
     :param seed: seed of each evaluation's first episode (episode k uses ``seed + k``): every evaluation starts from
         the same initial states
     :param on_row: called with every row as it is made
@@ -207,9 +209,11 @@ class LearningCurveCallback(BaseCallback):
         on_progress: Callable[[int], None] | None = None,
         progress_every: int = 500,
         verbose: int = 0,
+        final_episodes: int | None = None,
     ):
         super().__init__(verbose)
         self.eval_env, self.eval_freq, self.n_episodes, self.seed = eval_env, eval_freq, n_episodes, seed
+        self.final_episodes = n_episodes if final_episodes is None else final_episodes
         self.on_row, self.on_progress, self.progress_every = on_row, on_progress, progress_every
         self.paired_decodings = tuple(paired_decodings)
         self.rows: list[dict[str, Any]] = []
@@ -219,10 +223,11 @@ class LearningCurveCallback(BaseCallback):
         self.started = time.perf_counter()
         self.last_eval = self.num_timesteps - self.num_timesteps % self.eval_freq
 
-    def evaluate_now(self) -> dict[str, Any]:
-        """Evaluate the model at its current step; return the row."""
+    def evaluate_now(self, n_episodes: int | None = None) -> dict[str, Any]:
+        """Evaluate the model at its current step over ``n_episodes`` (default: the callback's); return the row."""
         self.train_seconds += time.perf_counter() - self.started
-        figures = rollout_figures(self.model, self.eval_env, self.n_episodes, seed=self.seed)
+        n_episodes = self.n_episodes if n_episodes is None else n_episodes
+        figures = rollout_figures(self.model, self.eval_env, n_episodes, seed=self.seed)
         row = {
             "step": self.num_timesteps,
             "train_seconds": round(self.train_seconds, 2),
@@ -234,7 +239,7 @@ class LearningCurveCallback(BaseCallback):
         paired = []
         for decoding in self.paired_decodings:
             with decoded_as(self.model, decoding):
-                read = rollout_figures(self.model, self.eval_env, self.n_episodes, seed=self.seed)
+                read = rollout_figures(self.model, self.eval_env, n_episodes, seed=self.seed)
             paired.append({**row, **read.as_dict(), "decoding": decoding})
         for made in (row, *paired):
             self.rows.append(made)
@@ -250,7 +255,9 @@ class LearningCurveCallback(BaseCallback):
         return row
 
     def _on_step(self) -> bool:
-        if self.num_timesteps - self.last_eval >= self.eval_freq:
+        # the evaluation at the end of the budget is the final one, with final_episodes (_on_training_end)
+        at_end = self.final_episodes != self.n_episodes and self.num_timesteps >= self.model._total_timesteps
+        if self.num_timesteps - self.last_eval >= self.eval_freq and not at_end:
             self.evaluate_now()
         if self.on_progress is not None and self.n_calls % self.progress_every == 0:
             self.on_progress(self.num_timesteps)
@@ -262,4 +269,4 @@ class LearningCurveCallback(BaseCallback):
 
     def _on_training_end(self) -> None:
         if self.num_timesteps > self.last_eval:
-            self.evaluate_now()
+            self.evaluate_now(self.final_episodes)

@@ -47,6 +47,11 @@ class DecQN(GQN):
     def __init__(self, *args: Any, bins: int | None = None, **kwargs: Any):
         if "growth" in kwargs and kwargs.pop("growth") is not None:
             raise ValueError("DecQN has a static resolution; use GQN for growth")
+        if kwargs.get("growth_kwargs"):
+            raise ValueError(
+                f"DecQN has a static resolution: growth_kwargs={kwargs['growth_kwargs']!r} would be ignored; use GQN "
+                "for growth"
+            )
         if bins is None:
             bins, args = static_bins(args, kwargs)
         if isinstance(bins, (bool, np.bool_)) or not isinstance(bins, (int, np.integer)):

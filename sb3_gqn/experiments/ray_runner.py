@@ -77,6 +77,7 @@ def train_remotely(
     board: Any,
     checkpoint_freq: int | None = None,
     checkpoint_dir: Path | None = None,
+    final_episodes: int | None = None,
 ) -> dict[str, bytes]:
     """The body of a Ray task: one run trained in a temporary folder; returns its files by relative path. With
     ``checkpoint_dir`` on storage every node sees, a retried task resumes from the run's last checkpoint there."""
@@ -94,6 +95,7 @@ def train_remotely(
             report_progress=lambda steps: board.report.remote(spec.name, steps),
             checkpoint_freq=checkpoint_freq,
             checkpoint_dir=checkpoint_dir,
+            final_episodes=final_episodes,
         )
         run_dir = out / "runs" / spec.name
         return {str(path.relative_to(run_dir)): path.read_bytes() for path in sorted(run_dir.rglob("*")) if path.is_file()}
@@ -126,6 +128,7 @@ def run_on_ray(
     retries: int = 3,
     checkpoint_freq: int | None = None,
     checkpoint_dir: Path | None = None,
+    final_episodes: int | None = None,
 ) -> dict[str, list[str]]:
     """Train ``pending`` as Ray tasks on the cluster at ``address`` and write each into ``out`` as it returns.
 
@@ -144,7 +147,7 @@ def run_on_ray(
         board = _progress_board(progress_board_name(out))
         task = ray.remote(train_remotely).options(num_cpus=threads, num_gpus=gpus, max_retries=retries, retry_exceptions=False)
         in_flight = {
-            task.remote(spec, eval_freq, eval_episodes, threads, board, checkpoint_freq, checkpoint_dir): spec
+            task.remote(spec, eval_freq, eval_episodes, threads, board, checkpoint_freq, checkpoint_dir, final_episodes): spec
             for spec in pending
         }
         print(f"submitted {len(in_flight)} runs to the Ray cluster at {address}", flush=True)

@@ -82,6 +82,11 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument("--full", action="store_true", help="paper-scale defaults (many machine-days)")
     parser.add_argument("--eval-freq", type=int, help="env steps between evaluations (default: steps / 10)")
     parser.add_argument("--eval-episodes", type=int, default=3, help="greedy episodes per evaluation")
+    parser.add_argument(
+        "--final-episodes",
+        type=int,
+        help="greedy episodes of the evaluation at the end of the budget (default: --eval-episodes)",
+    )
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
     parser.add_argument(
         "--threads", type=int, help="torch threads per run (default: cores / jobs; lower it when other work shares the cores)"
@@ -130,6 +135,7 @@ _MINIMUMS = {
     "steps": 1,
     "eval_freq": 1,
     "eval_episodes": 1,
+    "final_episodes": 1,
     "jobs": 1,
     "threads": 1,
     "checkpoint_freq": 0,
@@ -208,6 +214,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "sb3-gqn benchmark") -> 
             retries=args.ray_retries,
             checkpoint_freq=checkpointing[0],
             checkpoint_dir=checkpointing[1],
+            final_episodes=args.final_episodes,
         )
     elif pending:
         out.mkdir(parents=True, exist_ok=True)
@@ -238,8 +245,12 @@ def run_pending(
 ) -> None:
     """Train the pending runs in ``jobs`` local processes, printing progress."""
     by_name = {spec.name: spec for spec in pending}
+    final = args.final_episodes
     run_in_processes(
-        [(spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads, None, *checkpointing)) for spec in pending],
+        [
+            (spec.name, run, (spec, out, args.eval_freq, args.eval_episodes, threads, None, *checkpointing, final))
+            for spec in pending
+        ],
         jobs,
         on_finished=lambda name: print(f"finished {name}"),
         on_wait=lambda names: print(

@@ -51,6 +51,7 @@ COLUMNS = [
     "active_bins",
     "wall_time",
     "growth_events",
+    "growth_fractions",
     "deployed_bins",
     "deployments",
     "success",
@@ -69,6 +70,13 @@ def paired_decodings(model: Any) -> tuple[str, ...]:
     if getattr(model, "action_grid", None) is None or not hasattr(model, "decoding"):
         return ()
     return (PAIRED_DECODING[model.decoding],)
+
+
+def growth_fractions(growth_events: str, budget: int) -> str:
+    """A run's growth events (``"step:bins ..."``, the ``growth_events`` column) with each step as a fraction of its
+    budget: ``growth_fractions("12500:3 50000:5", 250_000)`` is ``"0.050:3 0.200:5"``."""
+    events = (event.split(":") for event in growth_events.split())
+    return " ".join(f"{int(step) / budget:.3f}:{bins}" for step, bins in events)
 
 
 def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
@@ -91,6 +99,7 @@ def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
         "active_bins": row["active_bins"],
         "wall_time": row["train_seconds"],
         "growth_events": row["growth_events"],
+        "growth_fractions": growth_fractions(row["growth_events"], spec.steps),
         "deployed_bins": row["deployed_bins"],
         "deployments": row["deployments"],
         "success": "" if math.isnan(row["success"]) else row["success"],
@@ -127,8 +136,12 @@ def run(
     report_progress: Callable[[int], None] | None = None,
     checkpoint_freq: int | None = None,
     checkpoint_dir: Path | None = None,
+    final_episodes: int | None = None,
 ) -> str:
     """Train and evaluate one run in this process; return its name. Skips a finished run.
+
+    Every ``eval_freq`` env steps ``eval_episodes`` greedy episodes, and ``final_episodes`` (default:
+    ``eval_episodes``) at the end of the budget.
 
     With ``checkpoint_freq`` (env steps), the run writes checkpoints (:mod:`~sb3_gqn.experiments.checkpoints`) into
     ``<checkpoint_dir>/<run>/`` (default: ``<out>/runs/<run>/checkpoints/``), and an interrupted run resumes from its
@@ -146,7 +159,9 @@ def run(
     with hold_run(spec, out):
         if done.is_file():  # the other process finished it
             return spec.name
-        return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
+        return _train(
+            spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir, final_episodes
+        )
 
 
 class RunInProgressError(RuntimeError):
@@ -200,6 +215,7 @@ def _train(
     report_progress: Callable[[int], None] | None,
     checkpoint_freq: int | None,
     checkpoint_dir: Path | None,
+    final_episodes: int | None = None,
 ) -> str:
     """:func:`run`'s training, with the run's lock held."""
     run_dir = out / "runs" / spec.name
@@ -255,7 +271,9 @@ def _train(
             stacklevel=2,
         )
         mark_damaged(checkpoint)
-        return _train(spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir)
+        return _train(
+            spec, out, eval_freq, eval_episodes, threads, report_progress, checkpoint_freq, checkpoint_dir, final_episodes
+        )
     assert experiment is not None  # rl-zoo3 returns None only when it optimizes hyperparameters
     model, _ = experiment
     eval_env = make_eval_env(spec)
@@ -273,6 +291,7 @@ def _train(
         on_row=lambda row: append_row(run_dir / "curve.csv", curve_row(spec, row)),
         paired_decodings=paired_decodings(model),
         on_progress=on_progress,
+        final_episodes=final_episodes,
     )
     callbacks: list[Any] = [*manager.callbacks, curve]
     # figure 2 snapshots Q over Pendulum's own (cos, sin, velocity) observations only

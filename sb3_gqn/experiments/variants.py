@@ -28,6 +28,7 @@ from typing import Any
 
 import gymnasium as gym
 
+from sb3_gqn.common.presets import PRESET_NAMES, preset_algorithm, zoo_hyperparams
 from sb3_gqn.zoo.hyperparams import read_entries, shipped_entry
 
 
@@ -62,6 +63,8 @@ VARIANTS: Mapping[str, Variant] = MappingProxyType(
         "td3": Variant("td3"),
         # SBX's SAC (JAX, the sbx extra): SAC with the same entries, run faster
         "sbx-sac": Variant("sbx_sac"),
+        # the paper's protocol (sb3_gqn.common.presets): gqn-paper, gqn-paper-linear, decqn-paper-2, decqn-paper-9
+        **{name: Variant(preset_algorithm(name), zoo_hyperparams(name)) for name in PRESET_NAMES},
     }
 )
 ZOO_ALGOS = ("gqn", "decqn", "sac", "td3", "sbx_sac")

@@ -99,8 +99,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         after ``g / (N + 1)`` of ``total_timesteps``) or ``None`` (stay at the first level)
     :param growth_kwargs: the growth settings: ``init`` (``"interpolate"``: an opened bin's head row starts as the mean
         of its two nested neighbours', so the greedy policy does not jump; ``"none"``: as the paper), and the adaptive
-        schedule's ``eval_freq``, ``eval_episodes``, ``window``, ``returns_source``, ``patience``, ``min_improvement``
-        and ``probation`` (:class:`~sb3_gqn.gqn.growth.AdaptiveGrowth`; checked whichever schedule runs)
+        schedule's ``eval_fraction`` (or ``eval_freq``), ``eval_episodes``, ``window``, ``returns_source``,
+        ``patience``, ``min_improvement`` and ``probation`` (:class:`~sb3_gqn.gqn.growth.AdaptiveGrowth`; refused by
+        name with another schedule)
     :param decoding: how deterministic ``predict`` and the exports turn utilities into actions: ``"argmax"``, the
         greedy bin (the paper); for ``Box`` action spaces the expected bin value under a softmax of the utilities over
         the deployed bins, tempered in the utilities' units (``"expectation"``) or relative to each state's spread of
@@ -384,7 +385,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         env_will_reset = reset_num_timesteps or self._last_obs is None
         if reset_num_timesteps:  # num_timesteps restarts at 0; growth_step goes on from the model's earlier steps
             self.growth_step_offset += self.num_timesteps
-        callbacks = with_growth_callback(callback, env_was_reset=env_will_reset)
+        callbacks = with_growth_callback(callback, env_was_reset=env_will_reset, new_run=reset_num_timesteps)
         total_timesteps, callback = super()._setup_learn(
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
         )

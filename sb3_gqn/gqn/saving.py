@@ -194,8 +194,8 @@ def upgrade_saved_settings(attributes: dict[str, Any]) -> None:
         check_growth_keys(settings, AdaptiveGrowth.SETTINGS)
         if schedule is not None:
             schedule.change_settings(**settings)
-        else:
-            AdaptiveGrowth(**settings)  # checked, as the constructor checks them for every schedule
+        else:  # refused by name, as the constructor refuses settings its schedule does not read
+            growth_settings(attributes.get("growth"), settings)
 
 
 class SavedFiles:

@@ -2,11 +2,13 @@
 hyperparameter files as defaults (``sb3-gqn train|enjoy|record-video``).
 
     sb3-gqn train --algo gqn --env dm_control/cartpole-swingup-v0
+    sb3-gqn train --preset gqn-paper --env dm_control/finger-turn_hard-v0
     sb3-gqn train --algo sac --env Pendulum-v1 -n 20000 --seed 1 -f logs
     sb3-gqn train --algo gqn --env Pendulum-v1 -optimize --n-trials 20 --storage postgresql://...
     sb3-gqn enjoy --algo gqn --env dm_control/cartpole-swingup-v0 -f logs --no-render -n 5000
 
-Every rl-zoo3 flag works, plus ``--n-envs N`` (short for ``-params n_envs:N``). Without ``-conf`` the algorithms the
+Every rl-zoo3 flag works, plus ``--n-envs N`` (short for ``-params n_envs:N``) and ``--preset NAME`` (a named
+configuration of :mod:`sb3_gqn.common.presets`, set over the env's entry). Without ``-conf`` the algorithms the
 project ships a file for (gqn, decqn, sac, td3) read ``sb3_gqn/zoo/hyperparams/<algo>.yml``, SBX's SAC (``--algo
 sbx_sac``, the ``sbx`` extra) reads SAC's; the others read rl-zoo3's own files. ``-optimize`` without ``--storage``
 keeps the study in ``<log folder>/<algo>/optuna.db`` (SQLite) under the name ``<algo>_<env>``. ``enjoy`` and
@@ -24,6 +26,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from sb3_gqn.common.presets import PRESET_NAMES, preset_algorithm, zoo_hyperparams
 from sb3_gqn.zoo.hyperparams import shipped_hyperparams
 from sb3_gqn.zoo.registration import ZOO_ALGOS, loader_without_replay_memory, register
 
@@ -46,9 +49,13 @@ def default_train_arguments(argv: Sequence[str]) -> list[str]:
     - ``--conf-file hyperparams/<algo>.yml`` for the algorithms the project ships a file for;
     - with ``-optimize``: an SQLite storage ``<log folder>/<algo>/optuna.db`` and the study name
       ``<algo>_<env>``, so that an interrupted study resumes and ``--trial-id`` can load from it;
-    - ``--n-envs N``, which rl-zoo3 reads only from the hyperparameters, becomes ``-params n_envs:N``.
+    - ``--n-envs N``, which rl-zoo3 reads only from the hyperparameters, becomes ``-params n_envs:N``;
+    - ``--preset NAME`` becomes ``--algo`` (the preset's algorithm, when not given) and the preset's settings in front
+      of the ``-params`` group (the user's own ``-params`` still win).
+
+    :raises ValueError: for an unknown preset, or an ``--algo`` that is not the preset's
     """
-    argv = _n_envs_as_hyperparameter(list(argv))
+    argv = _preset_as_hyperparameters(_n_envs_as_hyperparameter(list(argv)))
     algo = _option_value(argv, "--algo") or "ppo"
     config = shipped_hyperparams(algo)
     if config is not None and _option_value(argv, "-conf", "--conf-file") is None:
@@ -64,23 +71,49 @@ def default_train_arguments(argv: Sequence[str]) -> list[str]:
     return argv
 
 
-def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
-    n_envs = _option_value(argv, "--n-envs")
-    if n_envs is None:
-        return argv
+def _without_option(argv: list[str], name: str) -> list[str]:
+    """``argv`` without ``name value`` and ``name=value``."""
     kept: list[str] = []
     skip_next = False
     for argument in argv:
         if skip_next:
             skip_next = False
-        elif argument == "--n-envs":
+        elif argument == name:
             skip_next = True
-        elif not argument.startswith("--n-envs="):
+        elif not argument.startswith(name + "="):
             kept.append(argument)
-    for position, argument in enumerate(kept):
-        if argument in ("-params", "--hyperparams"):  # one StoreDict group: later groups would replace it
-            return [*kept[: position + 1], f"n_envs:{int(n_envs)}", *kept[position + 1 :]]
-    return [*kept, "-params", f"n_envs:{int(n_envs)}"]
+    return kept
+
+
+def _with_hyperparameters(argv: list[str], values: list[str]) -> list[str]:
+    """``argv`` with ``values`` (``key:expression``) at the front of its ``-params`` group (one StoreDict group: later
+    groups would replace it), or in a new group."""
+    for position, argument in enumerate(argv):
+        if argument in ("-params", "--hyperparams"):
+            return [*argv[: position + 1], *values, *argv[position + 1 :]]
+    return [*argv, "-params", *values]
+
+
+def _preset_as_hyperparameters(argv: list[str]) -> list[str]:
+    name = _option_value(argv, "--preset")
+    if name is None:
+        return argv
+    if name not in PRESET_NAMES:
+        raise ValueError(f"--preset {name!r} is not a preset: the presets are {', '.join(PRESET_NAMES)}")
+    algo, given = preset_algorithm(name), _option_value(argv, "--algo")
+    if given is not None and given != algo:
+        raise ValueError(f"--preset {name} trains --algo {algo}, not --algo {given}: leave --algo out")
+    kept = _without_option(argv, "--preset")
+    if given is None:
+        kept = ["--algo", algo, *kept]
+    return _with_hyperparameters(kept, [f"{key}:{value!r}" for key, value in zoo_hyperparams(name).items()])
+
+
+def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
+    n_envs = _option_value(argv, "--n-envs")
+    if n_envs is None:
+        return argv
+    return _with_hyperparameters(_without_option(argv, "--n-envs"), [f"n_envs:{int(n_envs)}"])
 
 
 def entry_template(env_id: str, action_space: Any | None = None) -> str:
@@ -212,6 +245,8 @@ help(sb3_gqn.GQN); a group given replaces the entry's. 0.2's flat keywords, grow
 with a DeprecationWarning). --n-envs N is short for
 -params n_envs:N; -optimize without --storage keeps its study in <log folder>/<algo>/optuna.db; -i <checkpoint.zip>
 continues with the checkpoint's replay buffer.
+--preset NAME trains a named configuration over the env's entry (its budget and action penalty kept): the paper's
+protocol as gqn-paper (bins 2 -> 9, eq. 4), gqn-paper-linear, decqn-paper-2 or decqn-paper-9 (sb3_gqn.paper_preset).
 
 rl-zoo3's options:
 """
@@ -220,7 +255,10 @@ rl-zoo3's options:
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
     """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
     os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
-    register([_option_value(sys.argv[1:] if argv is None else argv, "--algo")])
+    given = list(sys.argv[1:] if argv is None else argv)
+    preset = _option_value(given, "--preset")
+    algo = preset_algorithm(preset) if preset in PRESET_NAMES else _option_value(given, "--algo")
+    register([algo])
     return run_cli(_train, argv, prog=prog)
 
 

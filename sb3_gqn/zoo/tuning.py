@@ -67,6 +67,8 @@ def convert_gqn_params(params: dict[str, Any]) -> dict[str, Any]:
     hyperparams["policy_kwargs"] = dict(net_arch=NET_ARCHS[hyperparams.pop("net_arch")])
     if "growth_patience" in hyperparams:  # storages hold no None: 0 means the plateau rule is off
         hyperparams["growth_patience"] = int(hyperparams["growth_patience"]) or None
+        if hyperparams.get("growth") != "adaptive":  # the plateau rule is the adaptive schedule's: not read otherwise
+            hyperparams.pop("growth_patience")
     for name in [name for name in hyperparams if name in DEPRECATED_KEYWORDS]:
         group, key = DEPRECATED_KEYWORDS[name]
         hyperparams[group] = {**hyperparams.get(group, {}), key: hyperparams.pop(name)}

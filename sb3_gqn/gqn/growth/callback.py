@@ -17,18 +17,23 @@ class GrowthCallback(BaseCallback):
     """Applies the model's growth schedule after every environment step (installed by ``GQN.learn``).
 
     :param env_was_reset: whether ``learn()`` reset the environment (episodes in progress are lost)
+    :param new_run: whether ``learn()`` reset the step counter (a new run, whose ``total_timesteps`` is the adaptive
+        schedule's budget); ``False``: the run goes on with the budget fixed before
     """
 
     model: GQN
 
-    def __init__(self, env_was_reset: bool = True, verbose: int = 0):
+    def __init__(self, env_was_reset: bool = True, verbose: int = 0, new_run: bool = True):
         super().__init__(verbose)
         self.env_was_reset = env_was_reset
+        self.new_run = new_run
 
     def _on_training_start(self) -> None:
         schedule = self.model.growth_schedule
         if isinstance(schedule, AdaptiveGrowth):
-            schedule.start(self.model.n_envs, self.env_was_reset, self.model.growth_step)
+            # SB3's _total_timesteps: this learn()'s total_timesteps, plus the steps before it when the run goes on
+            budget = self.model._total_timesteps
+            schedule.start(self.model.n_envs, self.env_was_reset, self.model.growth_step, budget, self.new_run)
         self.model.logger.record("growth/active_bins", self.model.active_bins)
 
     def _on_step(self) -> bool:
@@ -68,7 +73,7 @@ class GrowthCallback(BaseCallback):
         return True
 
 
-def with_growth_callback(callback: MaybeCallback, env_was_reset: bool) -> list[BaseCallback]:
+def with_growth_callback(callback: MaybeCallback, env_was_reset: bool, new_run: bool = True) -> list[BaseCallback]:
     """``learn``'s ``callback`` as a list with a :class:`GrowthCallback` in front of the user's callbacks.
 
     :raises ValueError: for a ``callback`` that is not a ``BaseCallback``, a list of them, a callable or ``None``
@@ -83,4 +88,4 @@ def with_growth_callback(callback: MaybeCallback, env_was_reset: bool) -> list[B
         user_callbacks = [ConvertCallback(callback)]
     else:
         raise ValueError(f"callback must be a BaseCallback, a list of them, a callable or None, got {callback!r}")
-    return [GrowthCallback(env_was_reset=env_was_reset), *user_callbacks]
+    return [GrowthCallback(env_was_reset=env_was_reset, new_run=new_run), *user_callbacks]

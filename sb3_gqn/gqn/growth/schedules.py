@@ -37,6 +37,10 @@ GROWTH_SCHEDULES = ("adaptive", "linear", None)
 GROWTH_INITS = ("interpolate", "none")
 DEFAULT_GROWTH_INIT = "interpolate"
 RETURN_SOURCES = ("evaluation", "training")
+#: The adaptive schedule's default cadence: one greedy reading every 5 % of the run's budget (2 500 env steps of a
+#: 50k-step run, the cadence of the schedule before it read the budget); its window and patience, counted in readings,
+#: are then fractions of the budget too
+DEFAULT_EVAL_FRACTION = 0.05
 
 
 def _is_bin_count(value: object) -> TypeGuard[int | np.integer]:
@@ -220,7 +224,8 @@ class AdaptiveGrowth:
 
     Returns come either from greedy evaluation episodes (``returns_source="evaluation"``) or from
     every finished training episode (``"training"``). Evaluation episodes are interleaved with
-    training: every ``eval_freq`` environment steps, the next ``eval_episodes`` episodes that start
+    training: every ``eval_fraction`` of the run's budget (5 %: every 2 500 env steps of a 50k-step run, every 50 000
+    of a 1M-step run) or every ``eval_freq`` env steps when that is given, the next ``eval_episodes`` episodes that start
     act greedily over the active bins (no epsilon). Their transitions still go to the replay buffer
     and count as environment steps, so no separate evaluation env or extra budget is needed, and it
     works for any env, wrapper stack or VecEnv that GQN trains on.
@@ -247,8 +252,17 @@ class AdaptiveGrowth:
     GQN builds it from ``growth_kwargs`` (:func:`growth_settings`): its settings are the first seven fields
     (:attr:`SETTINGS`), the others the state that ``learn()`` moves on and ``save`` keeps.
 
+    The cadence reads the budget: with ``eval_fraction`` (the default), the readings, and so the window and the
+    patience (counted in readings) and the least time at a level (``max(window + 1, patience + 1)`` readings), are
+    fractions of the run's ``total_timesteps``, which the first ``learn()`` fixes (:attr:`budget`, saved with the
+    model). ``learn(..., reset_num_timesteps=False)`` and resumed runs keep it; ``learn()`` with a reset counter is a
+    new run with its own budget. ``eval_episodes`` stays a count of episodes (an episode's length does not scale with
+    the budget).
+
     :param eval_freq: environment steps between greedy evaluations, which are interleaved in training (their
-        transitions are stored and count as steps)
+        transitions are stored and count as steps); ``None`` (the default): ``eval_fraction`` of the budget
+    :param eval_fraction: the fraction of the run's budget between greedy evaluations (``0.05`` when neither it nor
+        ``eval_freq`` is given); give one of the two
     :param eval_episodes: greedy episodes averaged into one evaluation return
     :param window: number of past returns in eq. 4's moving mean and standard deviation
     :param returns_source: ``"evaluation"`` (greedy episodes) or ``"training"`` (every finished training episode)
@@ -264,6 +278,7 @@ class AdaptiveGrowth:
     #: The schedule's settings (``growth_kwargs`` keys besides ``init``); the other fields are its state
     SETTINGS: ClassVar[tuple[str, ...]] = (
         "eval_freq",
+        "eval_fraction",
         "eval_episodes",
         "window",
         "returns_source",
@@ -272,10 +287,12 @@ class AdaptiveGrowth:
         "probation",
     )
     #: What a schedule saved before a field existed ran with, where it is not the field's default: models saved
-    #: before the plateau rule ran eq. 4 alone (fields missing from this table take their defaults)
-    BEFORE_FIELD: ClassVar[dict[str, Any]] = {"patience": None}
+    #: before the plateau rule ran eq. 4 alone, and before the cadence read the budget every ``eval_freq`` steps
+    #: (fields missing from this table take their defaults)
+    BEFORE_FIELD: ClassVar[dict[str, Any]] = {"patience": None, "eval_fraction": None}
 
-    eval_freq: int = 2_500
+    eval_freq: int | None = None
+    eval_fraction: float | None = None
     eval_episodes: int = 1
     window: int = 3
     returns_source: str = "evaluation"
@@ -284,6 +301,8 @@ class AdaptiveGrowth:
     probation: int | None = None
     probation_reference: float | None = None
     probation_tries: int = 0
+    #: env steps of the run the cadence is a fraction of (set by ``learn()``; ``None`` before the first)
+    budget: int | None = None
     history: list[float] = field(default_factory=list)
     level_returns: list[float] = field(default_factory=list)
     next_eval_step: int = 0
@@ -295,7 +314,20 @@ class AdaptiveGrowth:
     def __post_init__(self) -> None:
         # The constructor's own checks (sb3_gqn.common.arguments), under the names GQN's growth_kwargs carry
         check_choice("growth_kwargs['returns_source']", self.returns_source, RETURN_SOURCES)
-        self.eval_freq = check_int("growth_kwargs['eval_freq']", self.eval_freq, 1)
+        if self.eval_freq is not None and self.eval_fraction is not None:
+            raise ValueError(
+                f"growth_kwargs sets both eval_freq={self.eval_freq!r} (env steps) and eval_fraction="
+                f"{self.eval_fraction!r} (of the budget) for the adaptive schedule's cadence: give one of them"
+            )
+        if self.eval_freq is not None:
+            self.eval_freq = check_int("growth_kwargs['eval_freq']", self.eval_freq, 1)
+        else:
+            fraction = DEFAULT_EVAL_FRACTION if self.eval_fraction is None else self.eval_fraction
+            self.eval_fraction = check_number("growth_kwargs['eval_fraction']", fraction, 0.0)
+            if not 0.0 < self.eval_fraction <= 1.0:
+                raise ValueError(
+                    f"growth_kwargs['eval_fraction'] must be in (0, 1] (a fraction of the run's budget), got {fraction!r}"
+                )
         self.eval_episodes = check_int("growth_kwargs['eval_episodes']", self.eval_episodes, 1)
         self.window = check_int("growth_kwargs['window']", self.window, 1)
         if self.patience is not None:
@@ -303,8 +335,16 @@ class AdaptiveGrowth:
         self.min_improvement = check_number("growth_kwargs['min_improvement']", self.min_improvement, 0.0)
         if self.probation is not None:
             self.probation = check_int("growth_kwargs['probation']", self.probation, 1)
-        if self.next_eval_step == 0:
-            self.next_eval_step = self.eval_freq
+
+    @property
+    def steps_between_readings(self) -> int:
+        """Env steps between greedy readings: ``eval_freq``, or ``eval_fraction`` of :attr:`budget` (at least 1;
+        before the first ``learn()`` fixes the budget, of a 50k-step run)."""
+        if self.eval_freq is not None:
+            return self.eval_freq
+        assert self.eval_fraction is not None, "__post_init__ sets one of eval_freq and eval_fraction"
+        budget = 50_000 if self.budget is None else self.budget
+        return max(1, round(self.eval_fraction * budget))
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         # Schedules saved before a field existed (0.1.0 had no plateau rule and no probation): what they ran with
@@ -323,9 +363,14 @@ class AdaptiveGrowth:
 
     def change_settings(self, **settings: Any) -> None:
         """Change settings (``load(path, growth_kwargs=...)``), checked as the constructor checks them; the state goes
-        on. ``ValueError`` naming a key that is not a setting."""
+        on. A new ``eval_freq`` replaces the cadence's ``eval_fraction`` and the other way round. ``ValueError``
+        naming a key that is not a setting."""
         check_growth_keys(settings, self.SETTINGS)
-        checked = AdaptiveGrowth(**{**self.settings(), **settings})
+        current = self.settings()
+        for given, other in (("eval_freq", "eval_fraction"), ("eval_fraction", "eval_freq")):
+            if settings.get(given) is not None and other not in settings:
+                current[other] = None
+        checked = AdaptiveGrowth(**{**current, **settings})
         for name in self.SETTINGS:
             setattr(self, name, getattr(checked, name))
 
@@ -334,15 +379,22 @@ class AdaptiveGrowth:
         """Whether an opened level waits to be deployed."""
         return self.probation_reference is not None
 
-    def start(self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0) -> None:
+    def start(
+        self, n_envs: int, env_was_reset: bool, num_timesteps: int = 0, budget: int | None = None, new_run: bool = True
+    ) -> None:
         """Prepare per-env bookkeeping at the start of ``learn()``.
 
-        When the env was reset (new run, ``set_env``, load), the episodes in progress are gone: their
-        partial returns are dropped and greedy evaluation episodes that were running are started again.
-        A run whose step counter was reset (``reset_num_timesteps=True``) evaluates ``eval_freq`` steps on.
+        A new run (``new_run``: ``learn()`` with ``reset_num_timesteps=True``) fixes :attr:`budget` to its ``budget``
+        (its ``total_timesteps``); a continued one (``reset_num_timesteps=False``, a resumed run) keeps the budget fixed
+        before, and takes ``budget`` only when none is. When the env was reset (new run, ``set_env``, load), the
+        episodes in progress are gone: their partial returns are dropped and greedy evaluation episodes that were
+        running are started again. A run whose step counter was reset evaluates one cadence on.
         """
-        if self.next_eval_step > num_timesteps + self.eval_freq:
-            self.next_eval_step = num_timesteps + self.eval_freq
+        if budget is not None and (new_run or self.budget is None):
+            self.budget = int(budget)
+        cadence = self.steps_between_readings
+        if self.next_eval_step == 0 or self.next_eval_step > num_timesteps + cadence:
+            self.next_eval_step = num_timesteps + cadence
         if env_was_reset or len(self.greedy_envs) != n_envs:
             self.pending_episodes += int(self.greedy_envs.sum())
             self.greedy_envs = np.zeros(n_envs, dtype=bool)
@@ -358,8 +410,11 @@ class AdaptiveGrowth:
     def observe(self, rewards: np.ndarray, dones: np.ndarray, num_timesteps: int) -> list[GrowthDecision]:
         """Account one vectorised env step; return the decisions made at episodes that just ended."""
         evaluating = self.returns_source == "evaluation"
+        if self.next_eval_step == 0:  # observed before start(): the first reading one cadence on
+            self.next_eval_step = self.steps_between_readings
         if evaluating and num_timesteps >= self.next_eval_step:
-            self.next_eval_step = (num_timesteps // self.eval_freq + 1) * self.eval_freq
+            cadence = self.steps_between_readings
+            self.next_eval_step = (num_timesteps // cadence + 1) * cadence
             if self.pending_episodes == 0 and not self.greedy_envs.any() and not self.finished_eval_returns:
                 self.pending_episodes = self.eval_episodes
         self.episode_returns += rewards
@@ -440,15 +495,26 @@ def check_growth_keys(growth_kwargs: dict[str, Any], valid: tuple[str, ...]) -> 
 def growth_settings(growth: str | None, growth_kwargs: dict[str, Any] | None) -> tuple[str, AdaptiveGrowth | None]:
     """GQN's ``growth`` and ``growth_kwargs`` checked: the warm start of opened bins (``growth_kwargs["init"]``,
     :data:`DEFAULT_GROWTH_INIT` when not given) and, for ``growth="adaptive"``, the schedule built from the other keys
-    (:class:`AdaptiveGrowth`'s settings, checked whichever schedule runs; its defaults where not given).
+    (:class:`AdaptiveGrowth`'s settings; its defaults where not given).
 
-    :raises ValueError: naming ``growth`` or the ``growth_kwargs`` key that is wrong
+    The adaptive schedule's settings are read only by ``growth="adaptive"``: with ``growth="linear"`` or ``None`` (where
+    only ``grow()`` by hand opens levels, reading ``init``) they are refused by name.
+
+    :raises ValueError: naming ``growth`` or the ``growth_kwargs`` key that is wrong or not read
     """
     check_choice("growth", growth, GROWTH_SCHEDULES)
     if growth_kwargs is not None and not isinstance(growth_kwargs, dict):
         raise ValueError(f"growth_kwargs must be a dict (or None), got {growth_kwargs!r}")
     settings = dict(growth_kwargs or {})
     check_growth_keys(settings, ("init", *AdaptiveGrowth.SETTINGS))
+    read = ("init", *AdaptiveGrowth.SETTINGS) if growth == "adaptive" else ("init",)
+    unread = sorted(str(key) for key in settings if key not in read)
+    if unread:
+        reads = f"reads only {', '.join(map(repr, read))}"
+        raise ValueError(
+            f"growth_kwargs {', '.join(map(repr, unread))} would be ignored: growth={growth!r} {reads} "
+            "(the adaptive schedule's settings need growth='adaptive')"
+        )
     init = settings.pop("init", DEFAULT_GROWTH_INIT)
     check_choice("growth_kwargs['init']", init, GROWTH_INITS)
     schedule = AdaptiveGrowth(**settings)
