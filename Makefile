@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 PYTEST_ARGS ?=
+# pytest-xdist workers for `make test` (2: the machine's cores; 0: one process, in the suite's own order)
+PYTEST_WORKERS ?= 2
 
 .PHONY: venv venv-myo results test test-slow test-myo lint typecheck docs benchmark results-page constraints constraints-myo clean
 
@@ -37,7 +39,7 @@ typecheck: venv
 	$(BIN)/mypy
 
 test: venv lint typecheck
-	$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS)
+	$(BIN)/python -m pytest -m "not slow" -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 test-slow: venv
 	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)

@@ -40,8 +40,23 @@ def test_reference_run_writes_results(tmp_path):
     saved = json.loads((run_dir / "final_evaluation.json").read_text())
     assert saved["final_evaluation"]["episodes"] == 2
     assert saved["timesteps"] >= 1200
-    # the Pendulum-v1 entry of hyperparams/gqn.yml was applied
-    assert saved["hyperparams"]["train_freq"] == "1"
+    # the Pendulum-v1 entry of hyperparams/gqn.yml was applied: its torso, and its bins (2, 9) in the run's name
+    assert "'net_arch': [256, 256]" in saved["hyperparams"]["policy_kwargs"]
+    assert summary["run"] == "gqn_linear_bins2-9_Pendulum_p0.1_seed0"
+    # the record names no folder of this machine
+    assert saved["args"]["hyperparams"] == "sb3_gqn/zoo/hyperparams/gqn.yml" and saved["args"]["out"] == ".."
+    assert str(tmp_path) not in (run_dir / "final_evaluation.json").read_text()
+
+
+def test_the_main_job_trains_the_class_defaults():
+    # make results' command: no --bins, --growth or --hyperparams: cartpole-swingup's entry, which sets only its
+    # budget, bins (3, 9), adaptive growth and the penalty wrappers
+    args = reference_run.parse_args(["--timesteps", "50000"])
+    hyperparams = reference_run.load_hyperparams(args.hyperparams, args.env)
+    reference_run.resolve_resolution(args, hyperparams)
+    assert (args.bins, args.growth) == ([3, 9], "adaptive")
+    assert hyperparams == {"n_timesteps": 70_000.0}
+    assert reference_run.run_name(args) == "gqn_adaptive_bins3-9_cartpole-swingup_p0.1_seed0"
 
 
 def test_load_hyperparams(tmp_path):

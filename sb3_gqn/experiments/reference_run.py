@@ -1,6 +1,6 @@
 """The project's main job: train GQN on a penalized DeepMind Control task and write its results.
 
-    sb3-gqn reference-run                       # cartpole-swingup, c = 0.1, the gqn.yml entry's arguments
+    sb3-gqn reference-run                       # cartpole-swingup, c = 0.1, the gqn.yml entry: the class defaults
     sb3-gqn reference-run --timesteps 20000 --out /tmp/smoke
 
 Writes to <out>/<run name>/: learning_curve.csv (greedy evaluation every --eval-freq steps: return, task
@@ -41,14 +41,16 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument("--env", default="dm_control/cartpole-swingup-v0", help="gymnasium env id")
     parser.add_argument("--penalty", type=float, default=0.1, help="action penalty coefficient c (0 for none)")
     parser.add_argument("--algo", choices=["gqn", "decqn"], default="gqn")
-    parser.add_argument("--bins", type=int, nargs="+", default=[2, 9], help="initial and final bins (one int: static)")
-    parser.add_argument("--growth", default="adaptive", choices=["adaptive", "linear", "none"])
+    parser.add_argument(
+        "--bins", type=int, nargs="+", help="initial and final bins (one int: static); default: the entry's, else (3, 9)"
+    )
+    parser.add_argument("--growth", choices=["adaptive", "linear", "none"], help="default: the entry's growth, else adaptive")
     parser.add_argument("--timesteps", type=int, default=None, help="default: the env's n_timesteps in --hyperparams")
     parser.add_argument(
         "--hyperparams",
         default=str(HYPERPARAMS_DIR / "gqn.yml"),
-        help="rl-zoo3-style file whose entry for --env supplies GQN's other arguments (train_freq, policy_kwargs, ...); "
-        "its bins and growth are ignored: --bins and --growth set them",
+        help="rl-zoo3-style file whose entry for --env supplies GQN's arguments (bins, growth, train_freq, "
+        "policy_kwargs, ...); --bins and --growth replace the entry's",
     )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
@@ -66,10 +68,11 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     args = parser.parse_args(argv)
     minimums = {"threads": 1, "eval_freq": 1, "eval_episodes": 1, "final_episodes": 1, "timesteps": 1, "seed": 0}
     refuse_below(parser, args, minimums)
-    if len(args.bins) > 2:
+    if args.bins is not None and len(args.bins) > 2:
         parser.error(f"--bins takes one int (static) or two (initial, final), got {args.bins}")
     try:
-        checked_bins(args.bins[0] if len(args.bins) == 1 else args.bins)
+        if args.bins is not None:
+            checked_bins(args.bins[0] if len(args.bins) == 1 else args.bins)
     except ValueError as error:
         parser.error(f"--bins: {error}")
     if not math.isfinite(args.penalty) or args.penalty < 0:
@@ -79,11 +82,11 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
 
 def load_hyperparams(path: str, env_id: str) -> dict[str, Any]:
     """GQN constructor arguments and ``n_timesteps`` of ``env_id``'s entry in an rl-zoo3-style YAML file ({} if the
-    file or the entry is absent); ``bins`` and ``growth`` come from the command line, the env is built here."""
+    file or the entry is absent); the env is built here."""
     if not Path(path).is_file():
         return {}
     entry = read_entries(path).get(env_id, {})
-    arguments = constructor_arguments({key: value for key, value in entry.items() if key not in ("bins", "growth")})
+    arguments = constructor_arguments(dict(entry))
     if "n_timesteps" in entry:
         arguments["n_timesteps"] = entry["n_timesteps"]
     return arguments
@@ -94,6 +97,27 @@ def run_name(args: argparse.Namespace) -> str:
     bins = "-".join(str(b) for b in args.bins)
     growth = f"_{args.growth}" if args.algo == "gqn" and len(args.bins) > 1 else ""
     return f"{args.algo}{growth}_bins{bins}_{env}_p{args.penalty:g}_seed{args.seed}"
+
+
+def resolve_resolution(args: argparse.Namespace, hyperparams: dict[str, Any]) -> None:
+    """``args.bins`` and ``args.growth`` where the command line left them out: the entry's (taken out of
+    ``hyperparams``), else the class defaults, ``(3, 9)`` and adaptive growth."""
+    entry_bins = hyperparams.pop("bins", None)
+    entry_growth = hyperparams.pop("growth", "adaptive")
+    if args.bins is None:
+        args.bins = [int(entry_bins)] if isinstance(entry_bins, int) else list(entry_bins or (3, 9))
+    if args.growth is None:
+        args.growth = "none" if entry_growth is None else str(entry_growth)
+
+
+def portable(path: str | Path, run_dir: Path) -> str:
+    """``path`` as a record writes it without the machine's folders: relative to the package's parent for a file of the
+    package (``sb3_gqn/zoo/hyperparams/gqn.yml``), else relative to the run folder ``run_dir``."""
+    resolved = Path(path).resolve()
+    package_parent = Path(__file__).resolve().parents[2]
+    if resolved.is_relative_to(package_parent / "sb3_gqn"):
+        return resolved.relative_to(package_parent).as_posix()
+    return Path(os.path.relpath(resolved, run_dir.resolve())).as_posix()
 
 
 def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
@@ -142,6 +166,7 @@ def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
     """Train, evaluate and write the run described by ``args`` (see :func:`parse_args`); return the summary that
     ``final_evaluation.json`` holds."""
     hyperparams = load_hyperparams(args.hyperparams, args.env)
+    resolve_resolution(args, hyperparams)
     n_timesteps = int(hyperparams.pop("n_timesteps", 100_000))
     args.timesteps = args.timesteps or n_timesteps
     out = Path(args.out) / run_name(args)
@@ -179,7 +204,7 @@ def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
     )
     summary = {
         "run": run_name(args),
-        "args": vars(args),
+        "args": {**vars(args), "hyperparams": portable(args.hyperparams, out), "out": portable(args.out, out)},
         "hyperparams": {key: str(value) for key, value in hyperparams.items()},
         "timesteps": model.num_timesteps,
         "gradient_steps": model._n_updates,

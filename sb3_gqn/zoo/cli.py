@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from sb3_gqn.common.presets import PRESET_NAMES, preset_algorithm, zoo_hyperparams
-from sb3_gqn.zoo.hyperparams import shipped_hyperparams
+from sb3_gqn.zoo.hyperparams import extended_hyperparams
 from sb3_gqn.zoo.registration import ZOO_ALGOS, loader_without_replay_memory, register
 
 
@@ -46,7 +46,8 @@ def _option_value(argv: Sequence[str], *names: str) -> str | None:
 def default_train_arguments(argv: Sequence[str]) -> list[str]:
     """rl-zoo3 train arguments with the project's defaults added where the user gave none:
 
-    - ``--conf-file hyperparams/<algo>.yml`` for the algorithms the project ships a file for;
+    - ``--conf-file``: for the algorithms the project ships a file for, that file extending rl-zoo3's own for the same
+      algorithm (:func:`~sb3_gqn.zoo.hyperparams.extended_hyperparams`, written under ``<log folder>/.hyperparams/``);
     - with ``-optimize``: an SQLite storage ``<log folder>/<algo>/optuna.db`` and the study name
       ``<algo>_<env>``, so that an interrupted study resumes and ``--trial-id`` can load from it;
     - ``--n-envs N``, which rl-zoo3 reads only from the hyperparameters, becomes ``-params n_envs:N``;
@@ -57,9 +58,11 @@ def default_train_arguments(argv: Sequence[str]) -> list[str]:
     """
     argv = _preset_as_hyperparameters(_n_envs_as_hyperparameter(list(argv)))
     algo = _option_value(argv, "--algo") or "ppo"
-    config = shipped_hyperparams(algo)
-    if config is not None and _option_value(argv, "-conf", "--conf-file") is None:
-        argv += ["--conf-file", str(config)]
+    if _option_value(argv, "-conf", "--conf-file") is None:
+        log_folder = Path(_option_value(argv, "-f", "--log-folder") or "logs")
+        config = extended_hyperparams(algo, log_folder / ".hyperparams")
+        if config is not None:
+            argv += ["--conf-file", str(config)]
     if "-optimize" in argv or "--optimize-hyperparameters" in argv:
         env_id = _option_value(argv, "--env") or "CartPole-v1"
         if _option_value(argv, "--storage") is None:
@@ -116,11 +119,42 @@ def _n_envs_as_hyperparameter(argv: list[str]) -> list[str]:
     return _with_hyperparameters(_without_option(argv, "--n-envs"), [f"n_envs:{int(n_envs)}"])
 
 
-def entry_template(env_id: str, action_space: Any | None = None) -> str:
-    """A hyperparameter entry, in rl-zoo3's YAML format, that trains GQN on ``env_id`` as printed.
+def builtin_control_cost(env: Any) -> float:
+    """The control cost an env's own reward already subtracts, as its weight (Gymnasium's MuJoCo tasks:
+    ``ctrl_cost_weight``, e.g. 0.1 for HalfCheetah, 1e-3 for Hopper; ``reward_control_weight`` for Reacher and
+    Pusher); 0 when it has none."""
+    unwrapped = getattr(env, "unwrapped", env)
+    for name in ("_ctrl_cost_weight", "_reward_control_weight"):
+        weight = getattr(unwrapped, name, None)
+        if isinstance(weight, (int, float)) and weight > 0:
+            return float(weight)
+    return 0.0
 
-    For a ``Box`` action space: the growing bins and the action penalty. For ``Discrete(n)`` (and ``MultiDiscrete``
-    with n choices everywhere): the bins GQN takes from such an env without ``bins``
+
+def _env_facts(env_id: str) -> tuple[Any | None, float]:
+    """``env_id``'s action space and built-in control cost weight; ``(None, 0)`` for an env that cannot be made."""
+    try:
+        import gymnasium as gym
+
+        from sb3_gqn.common.envs import register_envs
+
+        register_envs()
+        env = gym.make(env_id)
+        facts = env.action_space, builtin_control_cost(env)
+        env.close()
+        return facts
+    except Exception:  # the template is a hint: an env that cannot be made gets the Box entry
+        return None, 0.0
+
+
+def entry_template(env_id: str, action_space: Any | None = None, algo: str = "gqn", control_cost: float | None = None) -> str:
+    """A hyperparameter entry, in rl-zoo3's YAML format, that trains ``algo`` on ``env_id`` as printed.
+
+    GQN, for a ``Box`` action space: the growing bins and the action penalty; DecQN: its static 9 bins and the
+    penalty; any other algorithm (SAC, TD3, ...): rl-zoo3's MuJoCo defaults (``learning_starts: 10000``) and the
+    penalty. No template adds a penalty to an env whose reward already has a control cost (``control_cost``, read from
+    the env when not given: :func:`builtin_control_cost`): that cost is the penalty. For GQN and ``Discrete(n)`` (and
+    ``MultiDiscrete`` with n choices everywhere): the bins GQN takes from such an env without ``bins``
     (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`: the env's own n choices, growing from 3 when n is a nested
     level count 5, 9, 17, ..., static otherwise), and no penalty (it needs a ``Box``). ``action_space`` is read from
     the env when not given; an env that cannot be made gets the ``Box`` entry.
@@ -129,46 +163,45 @@ def entry_template(env_id: str, action_space: Any | None = None) -> str:
 
     from sb3_gqn.gqn.growth.schedules import default_bins
 
-    if action_space is None:
-        try:
-            import gymnasium as gym
-
-            from sb3_gqn.common.envs import register_envs
-
-            register_envs()
-            env = gym.make(env_id)
-            action_space = env.action_space
-            env.close()
-        except Exception:  # the template is a hint: an env that cannot be made gets the Box entry
-            action_space = None
+    if action_space is None or control_cost is None:
+        made_space, made_cost = _env_facts(env_id)
+        action_space = made_space if action_space is None else action_space
+        control_cost = made_cost if control_cost is None else control_cost
     lines = [f"{env_id}:", "  n_timesteps: !!float 2e5", "  policy: 'MlpPolicy'"]
+    penalty = (
+        [f"  # the env's own control cost ({control_cost:g} * sum(a^2)) is the action penalty"]
+        if control_cost > 0
+        else ["  env_wrapper:", "    - sb3_gqn.common.wrappers.ActionPenalty:", "        coef: 0.1"]
+    )
     even = isinstance(action_space, spaces.MultiDiscrete) and len(set(action_space.nvec.ravel().tolist())) == 1
+    if algo not in ("gqn", "decqn"):
+        return "\n".join(
+            [f"{env_id}:", "  n_timesteps: !!float 1e6", "  policy: 'MlpPolicy'", "  learning_starts: 10000", *penalty]
+        )
     if not (isinstance(action_space, spaces.Discrete) or even):
-        lines += [
-            "  bins: [3, 9]          # [9, 65] for velocity or position targets",
-            "  growth: 'adaptive'",
-            "  env_wrapper:",
-            "    - sb3_gqn.common.wrappers.ActionPenalty:",
-            "        coef: 0.1",
-        ]
-        return "\n".join(lines)
+        if algo == "decqn":
+            return "\n".join([*lines, "  bins: 9               # 65 for velocity or position targets", *penalty])
+        lines += ["  bins: [3, 9]          # [9, 65] for velocity or position targets", "  growth: 'adaptive'"]
+        return "\n".join([*lines, *penalty])
     assert action_space is not None  # a Discrete or an even MultiDiscrete space here
     bins, _ = default_bins(action_space)  # what GQN takes without bins: the same rule
-    if isinstance(bins, tuple):  # they grow: (initial, final)
+    if isinstance(bins, tuple) and algo == "gqn":  # they grow: (initial, final)
         initial, final = bins
         lines += [f"  bins: [{initial}, {final}]         # the env's {final} choices, opened from {initial}"]
         lines += ["  growth: 'adaptive'"]
     else:
-        lines += [f"  bins: {bins}              # the env's {bins} choices, static", "  growth: null"]
+        count = bins[-1] if isinstance(bins, tuple) else bins
+        lines += [f"  bins: {count}              # the env's {count} choices, static"]
+        lines += ["  growth: null"] if algo == "gqn" else []
     return "\n".join(lines)
 
 
-def missing_entry_hint(env_id: str) -> str:
-    """What to do when the hyperparameter file has no entry for ``env_id``: an entry that works for it, and where to
-    read how to choose its values."""
+def missing_entry_hint(env_id: str, algo: str = "gqn") -> str:
+    """What to do when the hyperparameter file has no entry for ``env_id``: an entry that works for it with ``algo``,
+    and where to read how to choose its values."""
     return (
         "This env has no entry in the hyperparameter file. Write one (rl-zoo3's YAML format) and pass the file with\n"
-        f"-conf my_hyperparams.yml, e.g. for this env:\n\n{entry_template(env_id)}\n\n"
+        f"-conf my_hyperparams.yml, e.g. for this env:\n\n{entry_template(env_id, algo=algo)}\n\n"
         'How to choose bins, growth, the penalty and train_freq: README, "Train GQN on your own task".'
     )
 
@@ -200,7 +233,8 @@ def run_cli(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: st
         message = str(error).strip().splitlines()[0] if str(error).strip() else ""
         print(f"{prog}: error: {type(error).__name__}: {message}", file=sys.stderr)
         if message.startswith("Hyperparameters not found"):
-            print(missing_entry_hint(_option_value(sys.argv[1:], "--env") or "my-env-v0"), file=sys.stderr)
+            env_id = _option_value(sys.argv[1:], "--env") or "my-env-v0"
+            print(missing_entry_hint(env_id, _option_value(sys.argv[1:], "--algo") or "gqn"), file=sys.stderr)
         if isinstance(error, (NameError, SyntaxError)) and _option_value(sys.argv[1:], "-params", "--hyperparams"):
             print(UNQUOTED_STRING_HINT, file=sys.stderr)
         return 1

@@ -3,6 +3,7 @@ every command uses."""
 
 from __future__ import annotations
 
+import os
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,40 @@ def shipped_hyperparams(algo: str) -> Path | None:
     ``sac``'s), if it ships one."""
     path = HYPERPARAMS_DIR / f"{SHARED_HYPERPARAMS.get(algo, algo)}.yml"
     return path if path.is_file() else None
+
+
+def zoo_own_hyperparams(algo: str) -> Path | None:
+    """rl-zoo3's own hyperparameter file for ``algo`` (``sbx_sac`` reads SAC's), if rl-zoo3 ships one."""
+    import rl_zoo3
+
+    path = Path(rl_zoo3.__file__).resolve().parent / "hyperparams" / f"{SHARED_HYPERPARAMS.get(algo, algo)}.yml"
+    return path if path.is_file() else None
+
+
+def extended_hyperparams(algo: str, folder: str | Path) -> Path | None:
+    """The file ``sb3-gqn train`` reads for ``algo``: the project's file extending rl-zoo3's own (its entries, then the
+    project's, which win for an env both have), written to ``folder/<algo>.yml``; the project's file alone when
+    rl-zoo3 has none for ``algo``; ``None`` when the project ships none (rl-zoo3's own file is read then).
+
+    So ``sb3-gqn train --algo sac --env HalfCheetah-v4`` finds rl-zoo3's tuned entry, and the project's penalized
+    entries are found beside it.
+    """
+    shipped = shipped_hyperparams(algo)
+    zoo_own = zoo_own_hyperparams(algo)
+    if shipped is None or zoo_own is None:
+        return shipped
+    target = Path(folder) / f"{SHARED_HYPERPARAMS.get(algo, algo)}.yml"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    # one YAML document: a key given twice takes its last value, so the project's entries replace rl-zoo3's
+    text = (
+        f"# rl-zoo3's {zoo_own.name}, then sb3-gqn's {shipped.name} (written by sb3-gqn train; its entries win)\n"
+        f"{zoo_own.read_text()}\n\n{shipped.read_text()}"
+    )
+    if not target.is_file() or target.read_text() != text:
+        scratch = target.with_suffix(f".{os.getpid()}.tmp")
+        scratch.write_text(text)
+        os.replace(scratch, target)
+    return target
 
 
 @cache
