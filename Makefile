@@ -27,7 +27,7 @@ venv-myo: $(MYO_VENV)/.installed
 # Main job (~7-10 min on 2 cores): GQN on penalized cartpole-swingup (learning curve, final evaluation), then the
 # short comparison suite (GQN vs DecQN 2/9 vs SAC on penalized Pendulum: table and plots) into results/
 results: venv
-	$(BIN)/sb3-gqn reference-run --out results --timesteps 50000 --threads 1
+	$(BIN)/sb3-gqn reference-run --out results --timesteps 40000 --threads 1
 	$(BIN)/sb3-gqn benchmark --out results/benchmark
 
 lint: venv

@@ -1,6 +1,8 @@
 """The hyperparameter files ``sb3-gqn train`` reads: the project's extend rl-zoo3's own, and each algorithm's template
 for an env without an entry is its own."""
 
+from pathlib import Path
+
 import yaml
 from gymnasium import spaces
 
@@ -27,7 +29,7 @@ def test_sb3_gqn_train_reads_the_extended_file(tmp_path):
     argv = default_train_arguments(["--algo", "td3", "--env", "HalfCheetah-v4", "-f", str(tmp_path)])
     config = argv[argv.index("--conf-file") + 1]
     assert config == str(tmp_path / ".hyperparams" / "td3.yml")
-    assert yaml.safe_load(open(config))["HalfCheetah-v4"]["policy_kwargs"] == "dict(net_arch=[400, 300])"
+    assert yaml.safe_load(Path(config).read_text())["HalfCheetah-v4"]["policy_kwargs"] == "dict(net_arch=[400, 300])"
 
 
 def test_v5_entries_equal_rl_zoo3s_v4_ones():

@@ -25,6 +25,7 @@ import paper_scale_blocks
 from page_cells import RESULTS, SETTINGS, difference_cell, interval_cell, replace_block, task_name
 
 from sb3_gqn.experiments.plots import aggregate, learning_curves, smoothness_radar
+from sb3_gqn.experiments.reference_run import plot_seeds
 from sb3_gqn.experiments.report import as_shipped, comparisons_across_tasks, comparisons_per_task, load, report_sections
 from sb3_gqn.experiments.scores import final_rows
 from sb3_gqn.experiments.significance import mean_interval
@@ -163,9 +164,9 @@ MAIN_JOB_ARGS = {
     "env": "dm_control/cartpole-swingup-v0",
     "penalty": 0.1,
     "algo": "gqn",
-    "bins": [2, 9],
+    "bins": [3, 9],
     "growth": "adaptive",
-    "timesteps": 50_000,
+    "timesteps": 40_000,
     "eval_freq": 5_000,
     "eval_episodes": 5,
     "final_episodes": 10,
@@ -406,6 +407,8 @@ def run() -> int:
     paper_scale_blocks.rebuild()
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
+    main_job_runs = sorted(path for path in (RESULTS / "reference_run").iterdir() if path.is_dir())
+    plot_seeds(main_job_runs, RESULTS / "main" / "main_job.png")
     replace_block(README, "development", development_block())
     for name, (path, agents) in SUITES.items():
         if (path / "results.csv").exists():

@@ -162,6 +162,43 @@ def plot_learning_curve(
     plt.close(figure)
 
 
+def plot_seeds(run_dirs: Sequence[Path], path: Path) -> None:
+    """The greedy return of several seeds of one run (their ``learning_curve.csv``) over env steps, one line per seed,
+    with a marker where each seed's levels opened (``final_evaluation.json``'s growth events), labelled with the bins.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axis = plt.subplots(figsize=(6.4, 4.2))
+    for run_dir in run_dirs:
+        with open(run_dir / "learning_curve.csv", newline="") as handle:
+            rows = list(csv.DictReader(handle))
+        summary = json.loads((run_dir / "final_evaluation.json").read_text())
+        steps = [0, *(int(row["step"]) for row in rows)]
+        returns = [float("nan"), *(float(row["return_"]) for row in rows)]
+        (line,) = axis.plot(steps[1:], returns[1:], marker="o", markersize=3, label=f"seed {summary['args']['seed']}")
+        for event in summary["growth_events"]:
+            # the return where the level opened: the curve's value at the last evaluation before it
+            before = max(index for index, step in enumerate(steps) if step <= int(event["step"]))
+            if before > 0:
+                axis.plot(int(event["step"]), returns[before], marker="^", color=line.get_color(), markersize=7)
+                axis.annotate(
+                    str(event["active_bins"]), (int(event["step"]), returns[before]), textcoords="offset points",
+                    xytext=(0, 6), ha="center", fontsize=7, color=line.get_color(),
+                )  # fmt: skip
+    axis.set_xlabel("environment steps")
+    axis.set_ylabel("episode return (greedy, penalized)")
+    axis.set_title("main job: GQN's class defaults on cartpole-swingup, c = 0.1 (triangles: bins opened)", fontsize=9)
+    axis.grid(alpha=0.3)
+    axis.legend(fontsize=8, loc="lower right")
+    figure.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
 def train_and_evaluate(args: argparse.Namespace) -> dict[str, Any]:
     """Train, evaluate and write the run described by ``args`` (see :func:`parse_args`); return the summary that
     ``final_evaluation.json`` holds."""
