@@ -79,6 +79,25 @@ def growth_fractions(growth_events: str, budget: int) -> str:
     return " ".join(f"{int(step) / budget:.3f}:{bins}" for step, bins in events)
 
 
+#: XLA's options that set its CPU thread pools, replaced by :func:`bound_jax_threads`
+_XLA_THREAD_FLAGS = ("--xla_cpu_multi_thread_eigen", "intra_op_parallelism_threads", "inter_op_parallelism_threads")
+
+
+def bound_jax_threads(threads: int) -> None:
+    """Bound JAX's CPU threads (SBX's agents) to ``threads``, as ``torch.set_num_threads`` bounds torch's: XLA's
+    ``--xla_cpu_multi_thread_eigen=false`` (one thread) or ``intra_op_parallelism_threads=threads`` in ``XLA_FLAGS``,
+    its other flags kept. XLA reads them when JAX makes its CPU backend, so a run sets them before its first JAX
+    computation; a backend made earlier in the process keeps its pools (a warning says so)."""
+    import sys
+
+    kept = [flag for flag in os.environ.get("XLA_FLAGS", "").split() if not flag.startswith(_XLA_THREAD_FLAGS)]
+    bounded = ["--xla_cpu_multi_thread_eigen=false"] if threads == 1 else []
+    os.environ["XLA_FLAGS"] = " ".join([*kept, *bounded, f"intra_op_parallelism_threads={threads}"])
+    backends = getattr(sys.modules.get("jax._src.xla_bridge"), "_backends", None)
+    if backends:
+        warnings.warn(f"JAX made its backend before --threads {threads} could bound it: its thread pools stay", stacklevel=2)
+
+
 def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
     """One ``results.csv`` row (:data:`COLUMNS`): run ``spec``'s learning-curve row (see
     :class:`~sb3_gqn.common.evaluation.LearningCurveCallback`) under the table's column names."""
@@ -242,6 +261,7 @@ def _train(
     from sb3_gqn.zoo.registration import register
 
     th.set_num_threads(threads)
+    bound_jax_threads(threads)
     zoo_algo, overrides = run_overrides(spec)
     register([zoo_algo])
     wrappers = run_wrappers(spec)
