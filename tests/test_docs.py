@@ -16,6 +16,9 @@ DOCUMENTS = [
     "docs/results/README.md",
     "docs/results/metaworld.md",
     "docs/results/myosuite.md",
+    "docs/results/paper-scale.md",
+    "docs/results/paper-protocol.md",
+    "docs/results/mujoco.md",
     "docs/research/README.md",
     "docs/research/benchmarks.md",
 ]

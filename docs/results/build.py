@@ -5,10 +5,11 @@ entry to the plain agent names (:func:`shipped`), and rewrites the blocks betwee
 ``<!-- END generated: NAME -->`` in ``docs/results/README.md`` (``main``) and ``README.md`` (``results``, and
 ``main-job`` from the committed reference runs in ``docs/results/reference_run/``, ``development`` from the
 development suite's runs in ``docs/results/development/``), the suite pages of :data:`SUITES` (``metaworld.md``,
-``myosuite.md``: their table and curves), ``paper-scale.md`` (its blocks are made by ``paper_scale_blocks.py``) and the
-figures in ``docs/results/main/``. The cells, links and block rewriting every page shares are in ``page_cells.py``, beside
-this script. The prose around the blocks is written by hand. Run from the repository root after extending a table with
-the comparison runner.
+``myosuite.md``: their table and curves), ``paper-scale.md`` (its blocks are made by ``paper_scale_blocks.py``),
+``paper-protocol.md`` and ``mujoco.md`` (``paper_protocol_blocks.py`` and ``mujoco_blocks.py``, each with its line in
+the README) and the figures in ``docs/results/main/``. The cells, links and block rewriting every page shares are in
+``page_cells.py``, beside this script. The prose around the blocks is written by hand. Run from the repository root
+after extending a table with the comparison runner.
 """
 
 from __future__ import annotations
@@ -19,8 +20,10 @@ import sys
 from collections.abc import Mapping
 from pathlib import Path
 
+import mujoco_blocks
 import numpy as np
 import pandas as pd
+import paper_protocol_blocks
 import paper_scale_blocks
 from page_cells import RESULTS, SETTINGS, difference_cell, interval_cell, replace_block, task_name
 
@@ -405,6 +408,8 @@ def run() -> int:
         replace_block(PAGE, "smooth-control", smooth_control_block(table))
     replace_block(PAGE, "smooth-default", smooth_default_block())
     paper_scale_blocks.rebuild()
+    paper_protocol_blocks.rebuild()
+    mujoco_blocks.rebuild()
     replace_block(README, "results", task_table(table))
     replace_block(README, "main-job", main_job_block())
     main_job_runs = sorted(path for path in (RESULTS / "reference_run").iterdir() if path.is_dir())
@@ -416,8 +421,9 @@ def run() -> int:
             replace_block(RESULTS / f"{name}.md", name, suite_block(suite, agents))
             learning_curves(suite, path)
     print(
-        f"rebuilt {PAGE} (main, smooth-control, smooth-default), {README} (results, main-job, development), the suite "
-        f"pages, paper-scale.md and the figures in {RESULTS / 'main'}"
+        f"rebuilt {PAGE} (main, smooth-control, smooth-default), {README} (results, main-job, development, "
+        f"paper-protocol-status, mujoco-status), the suite pages, paper-scale.md, paper-protocol.md, mujoco.md and the "
+        f"figures in {RESULTS / 'main'}"
     )
     return 0
 

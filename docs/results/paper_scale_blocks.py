@@ -36,6 +36,38 @@ def early_means(table: pd.DataFrame, fraction: float) -> pd.DataFrame:
     return early.groupby(keys, as_index=False)["return"].mean()
 
 
+#: the per-agent table's header (:func:`agent_rows`)
+AGENT_TABLE_HEADER = (
+    "| task | agent | seeds | return | task return | area under the curve | first-quarter return | SM | SM, relative |",
+    "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+)
+
+
+def agent_rows(
+    task: str, final: pd.DataFrame, early: pd.DataFrame, area: pd.DataFrame, agents: Mapping[str, str]
+) -> list[str]:
+    """The per-agent table's rows (:data:`AGENT_TABLE_HEADER`) of one task, labelled ``task``: for each agent of
+    ``agents`` (runner name: label) with runs in ``final`` (the task's final rows, paired readings as ``agent
+    (relative)``), its seeds, final return and task return, area under the curve and first-quarter return (``area`` and
+    ``early``: :func:`early_means` of the task's runs over the whole budget and its first quarter), each mean [95 %
+    interval] over seeds, and the mean SM with its own decoding and with the relative one."""
+    lines = []
+    for agent, label in agents.items():
+        agent_runs, relative = final[final["algo"] == agent], final[final["algo"] == f"{agent} (relative)"]
+        if agent_runs.empty:
+            continue
+        cells = [
+            interval_cell(agent_runs["return"].to_numpy(), 0),
+            interval_cell(agent_runs["task_return"].to_numpy(), 0),
+            interval_cell(area[area["algo"] == agent]["return"].to_numpy(), 0),
+            interval_cell(early[early["algo"] == agent]["return"].to_numpy(), 0),
+            f"{agent_runs['smoothness'].mean():.4f}",
+            f"{relative['smoothness'].mean():.4f}" if len(relative) else "-",
+        ]
+        lines.append(f"| {task} | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def paper_scale_block(table: pd.DataFrame) -> str:
     """The paper-scale runs per task: each agent's seeds, final return and task return, the area under the curve (the
     mean return over all of a run's evaluations, evenly spaced: the area over the budget) and the mean return over the
@@ -46,27 +78,12 @@ def paper_scale_block(table: pd.DataFrame) -> str:
     with the final task returns' difference and whether it matches (its interval holds 0). A comparison whose cells
     lack some of :data:`PAPER_SCALE_SEEDS` says so in place of its reading."""
     final, early, area = final_rows(table), early_means(table, PAPER_SCALE_EARLY), early_means(table, 1.0)
-    lines = [
-        "| task | agent | seeds | return | task return | area under the curve | first-quarter return | SM | SM, relative |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
-    ]
+    lines = list(AGENT_TABLE_HEADER)
     readings: list[str] = []
     for env, runs in final.groupby("env"):
         task = task_name(str(env))
         env_early, env_area = early[early["env"] == env], area[area["env"] == env]
-        for agent, label in PAPER_SCALE_AGENTS.items():
-            agent_runs, relative = runs[runs["algo"] == agent], runs[runs["algo"] == f"{agent} (relative)"]
-            if agent_runs.empty:
-                continue
-            cells = [
-                interval_cell(agent_runs["return"].to_numpy(), 0),
-                interval_cell(agent_runs["task_return"].to_numpy(), 0),
-                interval_cell(env_area[env_area["algo"] == agent]["return"].to_numpy(), 0),
-                interval_cell(env_early[env_early["algo"] == agent]["return"].to_numpy(), 0),
-                f"{agent_runs['smoothness'].mean():.4f}",
-                f"{relative['smoothness'].mean():.4f}" if len(relative) else "-",
-            ]
-            lines.append(f"| {task} | {label} | {len(agent_runs)} | " + " | ".join(cells) + " |")
+        lines += agent_rows(task, runs, env_early, env_area, PAPER_SCALE_AGENTS)
         for agent, baseline, reading in PAPER_SCALE_COMPARISONS:
             names = f"{PAPER_SCALE_AGENTS[agent]} - {PAPER_SCALE_AGENTS[baseline]}"
             source = env_early if reading == "early" else runs
@@ -93,32 +110,49 @@ def paper_scale_block(table: pd.DataFrame) -> str:
     return "\n".join(lines + (["", *readings] if readings else []))
 
 
-def resolved(values: list[np.ndarray], agent: str, baseline: str, pending: str | None) -> str:
+def resolved(
+    values: list[np.ndarray],
+    agent: str,
+    baseline: str,
+    pending: str | None,
+    labels: Mapping[str, str] = PAPER_SCALE_AGENTS,
+) -> str:
     """:func:`difference_cell` of ``agent``'s runs minus ``baseline``'s (``values``: the two, in that order) with the
-    plan's reading of it: the agent with the higher mean where the 95 % interval excludes 0, otherwise "no resolved
-    difference"; ``pending`` (why the comparison is not read yet) in its place while a cell lacks seeds."""
+    plan's reading of it: the agent with the higher mean (its label in ``labels``) where the 95 % interval excludes 0,
+    otherwise "no resolved difference"; ``pending`` (why the comparison is not read yet) in its place while a cell
+    lacks seeds."""
     difference, (low, high) = difference_interval(mean_difference, values[0], values[1])
     higher = agent if low > 0 else baseline if high < 0 else None
-    reading = pending or (f"{PAPER_SCALE_AGENTS[higher]} higher" if higher else "no resolved difference")
+    reading = pending or (f"{labels[higher]} higher" if higher else "no resolved difference")
     return f"{difference_text(difference, low, high)} ({reading})"
 
 
-def smoothness_reading(runs: pd.DataFrame, agent: str, baseline: str) -> str:
-    """``agent``'s final SM with its own decoding and the relative one over ``baseline``'s, and the final task returns'
-    difference: matched when its 95 % interval holds 0 (one run a side: when the difference is 0)."""
-    baseline_sm = runs[runs["algo"] == baseline]["smoothness"].mean()
+def smoothness_reading(
+    runs: pd.DataFrame,
+    agent: str,
+    baseline: str,
+    labels: Mapping[str, str] = PAPER_SCALE_AGENTS,
+    same_decoding: bool = False,
+) -> str:
+    """``agent``'s final SM with its own decoding and the relative one over ``baseline``'s own (with
+    ``same_decoding``: each over the baseline's with the same decoding), and the final task returns' difference:
+    matched when its 95 % interval holds 0 (one run a side: when the difference is 0); the agents by their
+    ``labels``."""
+
+    def sm(name: str) -> float:
+        return float(runs[runs["algo"] == name]["smoothness"].mean())
+
     ratios = [
-        f"{decoding} {runs[runs['algo'] == name]['smoothness'].mean() / baseline_sm:.2f}x"
-        for decoding, name in (("argmax", agent), ("relative", f"{agent} (relative)"))
+        f"{decoding} {sm(name) / sm(f'{baseline}{suffix}' if same_decoding else baseline):.2f}x"
+        for decoding, name, suffix in (("argmax", agent, ""), ("relative", f"{agent} (relative)", " (relative)"))
         if (runs["algo"] == name).any()
     ]
     task_returns = [runs[runs["algo"] == name]["task_return"].to_numpy() for name in (agent, baseline)]
     difference, (low, high) = difference_interval(mean_difference, *task_returns)
     matched = low <= 0 <= high if np.isfinite(low) else difference == 0
-    label = f"{PAPER_SCALE_AGENTS[agent]} over {PAPER_SCALE_AGENTS[baseline]}"
     return (
-        f"SM, {label}: {', '.join(ratios)}; final task return, {PAPER_SCALE_AGENTS[agent]} - "
-        f"{PAPER_SCALE_AGENTS[baseline]}: {difference_text(difference, low, high)} "
+        f"SM, {labels[agent]} over {labels[baseline]}: {', '.join(ratios)}; final task return, {labels[agent]} - "
+        f"{labels[baseline]}: {difference_text(difference, low, high)} "
         f"({'matched' if matched else 'not matched: the SM ratio compares unequal returns'})"
     )
 
