@@ -76,6 +76,25 @@ def test_radar_return_axis_keeps_larger_better_when_returns_are_negative(tmp_pat
     assert "no scale" not in " ".join(text.get_text() for text in figures[0].texts)
 
 
+def test_radar_compares_the_squared_actions_not_the_penalty_paid(tmp_path, monkeypatch):
+    """The reference trained without penalty paid nothing: its sum(a^2) of 100 still scales the action axis, where
+    decqn-9 at c = 0.5 (sum(a^2) = 200, paid 100) reads 2; the caption says what the axis holds."""
+    final = {"task_return": 500.0, "action_magnitude": 0.3, "action_change": 0.1, "smoothness": 0.01}
+    rows = [
+        {"algo": algo, "env": "A", "penalty": c, "seed": 0, "step": 100, **final, "action_squares": squares,
+         "penalty_paid": c * squares}
+        for algo, c, squares in (("gqn-adaptive", 0.0, 100.0), ("decqn-9", 0.5, 200.0))
+    ]  # fmt: skip
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    smoothness_radar(pd.DataFrame(rows), tmp_path)
+    [axis] = figures[0].axes
+    assert [label.get_text() for label in axis.get_xticklabels()] == ["R", "Σa²", "|a|", "|Δa|", "SM"]
+    by_label = {line.get_label(): line.get_ydata() for line in axis.get_lines()}
+    assert by_label["gqn-adaptive c=0"][1] == 1.0 and by_label["decqn-9 c=0.5"][1] == pytest.approx(2.0)
+    assert "squared actions summed over the episode (the action penalty paid is c·Σa²)" in figure_texts(figures[0])
+
+
 def test_radar_says_why_the_return_axis_is_empty_when_the_reference_scores_zero(tmp_path, monkeypatch):
     """A reference agent at task return 0 (a task nobody learned) gives R no scale: every R is drawn at 0, and the
     caption says why rather than leaving an empty axis unexplained."""
@@ -89,7 +108,7 @@ def test_radar_says_why_the_return_axis_is_empty_when_the_reference_scores_zero(
     smoothness_radar(pd.DataFrame(rows), tmp_path)
     [axis] = figures[0].axes
     assert all(line.get_ydata()[0] == 0.0 for line in axis.get_lines())
-    assert "the reference's task return is 0" in " ".join(text.get_text() for text in figures[0].texts)
+    assert "the reference's task return is 0" in figure_texts(figures[0])  # the caption, however it wraps
 
 
 def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):

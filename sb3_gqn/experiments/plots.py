@@ -22,25 +22,29 @@ from sb3_gqn.experiments.scores import (
     iqm_with_intervals,
     normalized_final_scores,
     run_growth_events,
+    with_action_columns,
     with_paired_readings,
 )
 
-#: Figure 4's axes: column of results.csv -> label
+#: Figure 4's axes: column of results.csv -> label. The action axis is ``Σa²`` (``action_squares``), not the penalty
+#: paid (``penalty_paid``, ``c·Σa²``): it compares agents trained at different c, and a reference trained without
+#: penalty (c = 0, nothing paid) still gives it a scale
 RADAR_METRICS = {
     "task_return": "R",
-    "action_penalty": "P",
+    "action_squares": "Σa²",
     "action_magnitude": "|a|",
     "action_change": "|Δa|",
     "smoothness": "SM",
 }
 RADAR_CAPTION = (
     "R: task return, 1 + (R - R_ref) / |R_ref| (the ratio when returns are positive; larger is better); "
-    "P: action penalty c·Σa², |a|: mean action magnitude, |Δa|: mean action change "
+    "Σa²: squared actions summed over the episode (the action penalty paid is c·Σa²), |a|: mean action magnitude, "
+    "|Δa|: mean action change "
     "between steps, SM: smoothness (spectral, higher frequencies weigh more): smaller is smoother. "
     "The other axes are ratios to the reference agent."
 )
 #: radar ratios above this are drawn at it, with their value written beside the point, so that one agent's
-#: outlier (e.g. decqn-2's action penalty, ~10x the reference's) does not squeeze every other line into the centre
+#: outlier (e.g. decqn-2's Σa², ~10x the reference's) does not squeeze every other line into the centre
 RADAR_CLIP = 4.0
 RADAR_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 RADAR_DASHES = ("-", "--", "-.", ":")
@@ -332,8 +336,11 @@ def return_radius(returns: np.ndarray, reference: float) -> np.ndarray:
 
 
 def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Figure 4 per env: R, P, ``|a|``, ``|Δa|``, SM of the final policies relative to the reference agent."""
+    """Figure 4 per env: R, ``Σa²``, ``|a|``, ``|Δa|``, SM of the final policies relative to the reference agent
+    (:data:`RADAR_METRICS`; a table of an earlier release is read under today's columns,
+    :func:`~sb3_gqn.experiments.scores.with_action_columns`)."""
     paths = []
+    table = with_action_columns(table)
     every_agent = sorted(str(algo) for algo in table["algo"].unique())
     for env, runs in final_rows(table).groupby("env"):
         reference = _reference(runs)
@@ -394,7 +401,7 @@ def smoothness_radar(table: pd.DataFrame, out: Path) -> list[Path]:
 
 def plot_suite(table_path: Path, out: Path, warnings: list[str] | None = None) -> list[Path]:
     """All figures for a results table; returns the written paths (``warnings``: see :func:`learning_curves`)."""
-    table = with_paired_readings(pd.read_csv(table_path))
+    table = with_paired_readings(with_action_columns(pd.read_csv(table_path)))
     if table.empty:
         return []
     paths = [*learning_curves(table, out, warnings), aggregate(table, out), *smoothness_radar(table, out)]

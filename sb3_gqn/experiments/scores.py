@@ -9,6 +9,22 @@ import pandas as pd
 from sb3_gqn.experiments.significance import seeded_numpy_global_generator
 
 
+def with_action_columns(table: pd.DataFrame) -> pd.DataFrame:
+    """The table under today's action columns: a table of an earlier release held ``Σa²`` (the squared actions summed
+    over the episode: the penalty at c = 1) under ``action_penalty``; it becomes ``action_squares``, and
+    ``penalty_paid``, the penalty the agent paid, is each row's ``penalty`` times it (see
+    :func:`~sb3_gqn.experiments.runs.upgraded_row`). Today's tables, and tables without the column, are unchanged."""
+    if "action_penalty" not in table.columns or "action_squares" in table.columns:
+        return table
+    upgraded = table.rename(columns={"action_penalty": "action_squares"})
+    upgraded.insert(
+        list(upgraded.columns).index("action_squares") + 1,
+        "penalty_paid",
+        upgraded["penalty"] * upgraded["action_squares"],
+    )
+    return upgraded
+
+
 def with_paired_readings(table: pd.DataFrame) -> pd.DataFrame:
     """The table with every paired reading (a row whose ``decoding`` names the decoding that read the run's model
     beside its own, see :data:`~sb3_gqn.experiments.runs.PAIRED_DECODING`) as an agent of its own, ``algo (decoding)``:
