@@ -41,3 +41,20 @@ def test_the_python_m_entry_points_of_0_1_0_still_run(module):
     )
     assert completed.returncode == 0, completed.stderr
     assert "usage:" in completed.stdout
+
+
+@pytest.mark.parametrize("command", ["train", "enjoy"])
+def test_an_unknown_algorithm_is_refused_with_every_name_there_is(command, capsys):
+    assert main([command, "--algo", "sbxsac", "--env", "Pendulum-v1"]) == 2
+    err = capsys.readouterr().err
+    assert f"sb3-gqn {command}: error: --algo 'sbxsac' is not an algorithm: the algorithms are " in err
+    listed = err.split("the algorithms are ", 1)[1].split(" (", 1)[0].split(", ")
+    # rl-zoo3's own, the project's and SBX's SAC (named whether or not the sbx extra is installed)
+    assert {"gqn", "decqn", "sac", "td3", "ppo", "sbx_sac"} <= set(listed) and listed == sorted(listed)
+    assert "also as sbx-sac" in err
+
+
+def test_the_train_help_names_both_spellings_of_sbx_sac():
+    from sb3_gqn.zoo.cli import TRAIN_HELP
+
+    assert "sbx_sac" in TRAIN_HELP and "sbx-sac" in TRAIN_HELP

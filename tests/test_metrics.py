@@ -76,12 +76,48 @@ def test_rollout_figures_by_hand():
     figures = rollout_figures(ScriptedPolicy(), env, n_episodes=2)
     scaled = np.array([1.0, 1.0, -1.0, 0.0])
     assert figures.task_return == pytest.approx(4.0)  # info["task_reward"], not the penalized reward
-    assert figures.penalty == pytest.approx(3.0)  # 1 + 1 + 1 + 0
+    assert figures.action_squares == pytest.approx(3.0)  # 1 + 1 + 1 + 0
+    assert figures.penalty_paid == pytest.approx(0.5 * 3.0)  # what ActionPenalty(0.5) took
     assert figures.return_ == pytest.approx(4.0 - 0.5 * 3.0)
     assert figures.action_magnitude == pytest.approx(0.75)
     assert figures.action_change == pytest.approx((0 + 2 + 1) / 3)
     assert figures.smoothness == pytest.approx(smoothness(scaled, 10.0))
     assert (figures.freq, figures.episodes, figures.episode_length) == (10.0, 2, 4.0)
+
+
+class TwoDimensionalEnv(gym.Env):
+    """10-step episodes, reward 1 per step, two action dimensions in [-1, 1]."""
+
+    observation_space = spaces.Box(0.0, 10.0, (1,), np.float32)
+    action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.t = 0
+        return np.array([0.0], np.float32), {}
+
+    def step(self, action):
+        self.t += 1
+        return np.array([self.t], np.float32), 1.0, False, self.t >= 10, {}
+
+
+class FullThrottle:
+    """Action (1, -1) at every step: |a| = 1 in both dimensions."""
+
+    def predict(self, observation, deterministic=True):
+        return np.array([1.0, -1.0], np.float32), None
+
+
+def test_the_action_figures_say_the_squares_and_the_penalty_paid_apart():
+    """2 dimensions at |a| = 1 for 10 steps: sum(a^2) = 20; under ActionPenalty(0.5) the agent pays 0.5 * 20 = 10."""
+    figures = rollout_figures(FullThrottle(), ActionPenalty(TwoDimensionalEnv(), coef=0.5), n_episodes=2)
+    assert figures.action_squares == pytest.approx(20.0)
+    assert figures.penalty_paid == pytest.approx(10.0)
+    assert (figures.task_return, figures.return_) == (pytest.approx(10.0), pytest.approx(10.0 - 10.0))
+    unpenalized = rollout_figures(FullThrottle(), TwoDimensionalEnv(), n_episodes=1)
+    assert (unpenalized.action_squares, unpenalized.penalty_paid) == (pytest.approx(20.0), 0.0)  # nothing to pay
+    with pytest.warns(DeprecationWarning, match="action_squares"):
+        assert figures.penalty == pytest.approx(20.0)  # the old name held the squares
 
 
 def test_normalized_actions_and_box_only():

@@ -76,6 +76,25 @@ def test_radar_return_axis_keeps_larger_better_when_returns_are_negative(tmp_pat
     assert "no scale" not in " ".join(text.get_text() for text in figures[0].texts)
 
 
+def test_radar_compares_the_squared_actions_not_the_penalty_paid(tmp_path, monkeypatch):
+    """The reference trained without penalty paid nothing: its sum(a^2) of 100 still scales the action axis, where
+    decqn-9 at c = 0.5 (sum(a^2) = 200, paid 100) reads 2; the caption says what the axis holds."""
+    final = {"task_return": 500.0, "action_magnitude": 0.3, "action_change": 0.1, "smoothness": 0.01}
+    rows = [
+        {"algo": algo, "env": "A", "penalty": c, "seed": 0, "step": 100, **final, "action_squares": squares,
+         "penalty_paid": c * squares}
+        for algo, c, squares in (("gqn-adaptive", 0.0, 100.0), ("decqn-9", 0.5, 200.0))
+    ]  # fmt: skip
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    smoothness_radar(pd.DataFrame(rows), tmp_path)
+    [axis] = figures[0].axes
+    assert [label.get_text() for label in axis.get_xticklabels()] == ["R", "Σa²", "|a|", "|Δa|", "SM"]
+    by_label = {line.get_label(): line.get_ydata() for line in axis.get_lines()}
+    assert by_label["gqn-adaptive c=0"][1] == 1.0 and by_label["decqn-9 c=0.5"][1] == pytest.approx(2.0)
+    assert "squared actions summed over the episode (the action penalty paid is c·Σa²)" in figure_texts(figures[0])
+
+
 def test_radar_says_why_the_return_axis_is_empty_when_the_reference_scores_zero(tmp_path, monkeypatch):
     """A reference agent at task return 0 (a task nobody learned) gives R no scale: every R is drawn at 0, and the
     caption says why rather than leaving an empty axis unexplained."""
@@ -89,7 +108,7 @@ def test_radar_says_why_the_return_axis_is_empty_when_the_reference_scores_zero(
     smoothness_radar(pd.DataFrame(rows), tmp_path)
     [axis] = figures[0].axes
     assert all(line.get_ydata()[0] == 0.0 for line in axis.get_lines())
-    assert "the reference's task return is 0" in " ".join(text.get_text() for text in figures[0].texts)
+    assert "the reference's task return is 0" in figure_texts(figures[0])  # the caption, however it wraps
 
 
 def test_q_value_snapshots_carry_each_bins_action_value(tmp_path):
@@ -295,3 +314,199 @@ def test_a_wrapped_left_out_note_stays_clear_of_the_legend(tmp_path, monkeypatch
     [legend] = figure.legends
     assert not legend.get_window_extent(renderer).overlaps(note.get_window_extent(renderer))
     assert not any(note.get_window_extent(renderer).overlaps(axis.get_window_extent(renderer)) for axis in figure.axes)
+
+
+def texts_outside(figure) -> list[str]:
+    """The drawn texts of ``figure`` (labels, titles, notes, legends, tick labels) that reach past its edges."""
+    from matplotlib.text import Text
+
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    frame = figure.bbox
+    undrawn = set()  # the labels of ticks outside an axis' view: matplotlib keeps them, but does not draw them
+    for panel in figure.axes:
+        for axis in (panel.xaxis, panel.yaxis):
+            low, high = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not low - 1e-9 * (high - low) <= tick.get_loc() <= high + 1e-9 * (high - low):
+                    undrawn |= {id(tick.label1), id(tick.label2)}
+    outside = []
+    for text in figure.findobj(Text):
+        if id(text) in undrawn or not (text.get_visible() and text.get_text().strip()):
+            continue
+        box = text.get_window_extent(renderer)
+        if box.x0 < frame.x0 - 0.5 or box.y0 < frame.y0 - 0.5 or box.x1 > frame.x1 + 0.5 or box.y1 > frame.y1 + 0.5:
+            outside.append(text.get_text())
+    return outside
+
+
+def evaluations(algo: str, returns: tuple[float, ...], decoding: str = "", **columns) -> list[dict]:
+    """One seed's evaluations at steps 100, 200, ... with ``returns``; ``decoding`` set for a paired reading."""
+    return [
+        {"algo": algo, "env": "Pendulum-v1", "penalty": 0.1, "seed": 0, "step": 100 * (index + 1), "return": value,
+         "task_return": value, "action_squares": 10.0, "penalty_paid": 1.0, "action_magnitude": 0.5,
+         "action_change": 0.1, "smoothness": 0.01, "wall_time": 10.0 * (index + 1), "growth_events": "",
+         "decoding": decoding, **columns}
+        for index, value in enumerate(returns)
+    ]  # fmt: skip
+
+
+def line_styles(axis) -> dict[str, tuple[str, str]]:
+    """Each labelled line of ``axis``: its colour (hex) and line style."""
+    from matplotlib.colors import to_hex
+
+    return {
+        line.get_label(): (to_hex(line.get_color()), line.get_linestyle())
+        for line in axis.get_lines()
+        if not line.get_label().startswith("_")
+    }
+
+
+def test_figures_draw_each_agent_once_and_its_paired_reading_only_when_asked(tmp_path, monkeypatch):
+    """gqn-linear's runs are also read with the relative decoding (rows with ``decoding`` set): one line per agent by
+    default; with ``paired``, the reading is a dashed line of gqn-linear's colour, labelled ``gqn-linear (relative)``."""
+    from sb3_gqn.experiments.scores import with_paired_readings
+
+    results = pd.DataFrame(
+        evaluations("gqn-linear", (-900.0, -800.0))
+        + evaluations("gqn-linear", (-850.0, -700.0), decoding="relative")
+        + evaluations("sac", (-1000.0, -950.0))
+    )
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    olive, purple = "#bcbd22", "#9467bd"  # tab:olive, tab:purple
+    for table in (results, with_paired_readings(results)):  # as results.csv holds it, and as the report reads it
+        figures.clear()
+        plots.learning_curves(table, tmp_path)
+        steps_panel = figures[0].axes[0]
+        assert line_styles(steps_panel) == {"gqn-linear, 1 seed": (olive, "-"), "sac, 1 seed": (purple, "-")}
+        assert [list(line.get_ydata()) for line in steps_panel.get_lines()] == [[-900.0, -800.0], [-1000.0, -950.0]]
+        plots.learning_curves(table, tmp_path, paired=True)
+        for panel in figures[1].axes:
+            drawn = [(line.get_color(), line.get_linestyle()) for line in panel.get_lines()]
+            assert len(drawn) == 3 and len(set(drawn)) == 3  # no line hides under another of its colour and style
+        assert line_styles(figures[1].axes[0]) == {
+            "gqn-linear, 1 seed": (olive, "-"),
+            "gqn-linear (relative), 1 seed": (olive, "--"),
+            "sac, 1 seed": (purple, "-"),
+        }
+        assert list(figures[1].axes[0].get_lines()[1].get_ydata()) == [-850.0, -700.0]
+        assert "Every agent of the table is drawn." in figure_texts(figures[1])
+        plots.aggregate(table, tmp_path, reps=20)
+        plots.aggregate(table, tmp_path, reps=20, paired=True)
+        names = [[label.get_text() for label in figure.axes[0].get_yticklabels()] for figure in figures[2:]]
+        assert [[name.split("\n")[0] for name in row] for row in names] == [
+            ["sac", "gqn-linear"],
+            ["sac", "gqn-linear", "gqn-linear (relative)"],  # by IQM: -950, -800, -700
+        ]
+        smoothness_radar(table, tmp_path)
+        smoothness_radar(table, tmp_path, paired=True)
+        radar_lines = [line_styles(figure.axes[0]) for figure in figures[4:]]
+        assert {label: color for label, (color, _) in radar_lines[0].items()} == {
+            "gqn-linear c=0.1": olive,
+            "sac c=0.1": purple,
+        }
+        assert radar_lines[1]["gqn-linear (relative) c=0.1"][0] == olive
+
+
+def test_the_iqm_of_one_task_draws_raw_returns_and_says_so(tmp_path, monkeypatch):
+    """One task: min-max normalizing over the agents would draw the worst at 0 and the best at 1 whatever their returns
+    (-1276, -1185, -906: 0, 0.25, 1); the figure draws the returns, its axis label says they are raw."""
+    from matplotlib.collections import LineCollection
+
+    from sb3_gqn.experiments.scores import iqm_scores
+
+    finals = (("decqn-2", -1276.0), ("decqn-9", -1185.0), ("gqn-linear", -906.0))
+    results = pd.DataFrame([row for algo, value in finals for row in evaluations(algo, (-1500.0, value))])
+    scores, tasks, normalized = iqm_scores(results)
+    assert (tasks, normalized) == ([("Pendulum-v1", 0.1)], False)
+    assert {algo: values.tolist() for algo, values in scores.items()} == {
+        "decqn-2": [[-1276.0]],
+        "decqn-9": [[-1185.0]],
+        "gqn-linear": [[-906.0]],
+    }
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    aggregate(results, tmp_path, reps=20)
+    axis = figures[0].axes[0]
+    estimates = sorted(float(segment[0][0]) for line in axis.collections if isinstance(line, LineCollection)
+                       for segment in line.get_segments())  # fmt: skip
+    assert estimates == [-1276.0, -1185.0, -906.0]
+    assert "raw: not normalized" in axis.get_xlabel()
+    # two tasks: normalized, and the label says how
+    other = results.assign(env="Other-v0", **{"return": results["return"] + 100.0})
+    assert iqm_scores(pd.concat([results, other]))[2] is True
+    aggregate(pd.concat([results, other]), tmp_path, reps=20)
+    assert "min-max normalized per task" in figures[1].axes[0].get_xlabel()
+
+
+def test_every_text_of_the_iqm_figure_stays_inside_it(tmp_path, monkeypatch):
+    """Agents with one run per task have no interval: the figure says so within its edges, also when long names leave
+    the panel narrow."""
+    from matplotlib.text import Text
+
+    finals = {"decqn-2+layernorm+1update": -1276.0, "decqn-9+layernorm+1update": -1185.0, "sac": -1000.0}
+    finals["gqn-adaptive+layernorm+1update"] = -906.0
+    results = pd.DataFrame([row for algo, value in finals.items() for row in evaluations(algo, (-1500.0, value))])
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    aggregate(results, tmp_path, reps=20)
+    figure = figures[0]
+    assert "1 run per task: no CI" in " ".join(text.get_text() for text in figure.findobj(Text))
+    assert texts_outside(figure) == []
+
+
+def test_growth_labels_of_close_events_merge_and_keep_clear_of_each_other_and_the_ticks(tmp_path, monkeypatch):
+    """gqn-adaptive grows to 3 and 5 bins 100 steps apart (1 % of the panel: their labels would overlap), then to 9;
+    gqn-linear to 3 at the same step as gqn-adaptive and to 5 at the last evaluation's step."""
+    from matplotlib.colors import to_hex
+
+    steps = tuple(float(-1500 + 50 * index) for index in range(10))
+    adaptive, linear = "1000:3 1100:5 5000:9", "1000:3 1000:5 10000:9"
+    results = pd.DataFrame(
+        evaluations("gqn-adaptive", steps, growth_events=adaptive)
+        + evaluations("gqn-linear", steps, growth_events=linear)
+        + evaluations("sac", steps)
+    )
+    results["step"] *= 10  # evaluations at 1000, 2000, ..., 10 000
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    plots.learning_curves(results, tmp_path)
+    figure = figures[0]
+    panel = figure.axes[0]
+    labels = [text for text in panel.texts if text.get_text()]
+    by_agent = {
+        agent: sorted(text.get_text() for text in labels if to_hex(text.get_color()) == to_hex(plots.agent_color(agent)))
+        for agent in ("gqn-adaptive", "gqn-linear")
+    }
+    assert by_agent == {"gqn-adaptive": ["3, 5", "9"], "gqn-linear": ["3, 5", "9"]}
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    boxes = [text.get_window_extent(renderer) for text in labels]
+    inside = panel.get_window_extent(renderer)
+    ticks = [tick.get_window_extent(renderer) for tick in panel.get_xticklabels() + panel.get_yticklabels() if tick.get_text()]
+    for index, box in enumerate(boxes):
+        assert inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0 and box.y1 <= inside.y1
+        assert not any(box.overlaps(other) for other in boxes[index + 1 :])
+        assert not any(box.overlaps(tick) for tick in ticks)
+    # the labels sit above every curve: the panel's top was raised for them
+    top_of_curves = max(max(line.get_ydata()) for line in panel.get_lines() if len(line.get_ydata()))
+    assert all(panel.transData.inverted().transform((0, box.y0))[1] > top_of_curves for box in boxes)
+
+
+def test_the_wall_time_panel_marks_each_curves_first_evaluation_and_says_it_includes_start_up(tmp_path, monkeypatch):
+    """SBX's first evaluation comes after JAX compiled (40 s here, then 10 s per evaluation): the curve starts at its
+    first evaluation, marked, and the axis label says that point's time includes the start-up."""
+    results = pd.DataFrame(
+        evaluations("sbx-sac", (-1400.0, -1200.0, -1000.0)) + evaluations("sac", (-1400.0, -1250.0, -1100.0))
+    )
+    results.loc[results["algo"] == "sbx-sac", "wall_time"] += 30.0  # 40, 50, 60 s
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    plots.learning_curves(results, tmp_path)
+    wall_panel = figures[0].axes[1]
+    for line, first in zip(wall_panel.get_lines(), (10.0, 40.0)):  # sac, then sbx-sac
+        assert line.get_xdata()[0] == first  # no origin before the first evaluation
+        assert (line.get_marker(), line.get_markevery(), line.get_markerfacecolor()) == ("o", [0], "white")
+    assert "first evaluation" in wall_panel.get_xlabel() and "start-up" in wall_panel.get_xlabel()
+    assert texts_outside(figures[0]) == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 
 from sb3_gqn.experiments.report import as_shipped, growth_checks, held_after_growth, main, report, select
 from sb3_gqn.experiments.variants import with_variants_files
@@ -156,3 +157,83 @@ def test_report_filters_the_runs_and_refuses_a_value_no_run_has(tmp_path, capsys
     for flag, value in (("--seeds", "7"), ("--penalties", "0.3"), ("--envs", "Pendulum-v1"), ("--algos", "sac")):
         assert main([str(path), flag, value]) == 2
         assert f"{flag}: no runs of {value}" in capsys.readouterr().err
+
+
+def test_a_results_row_holds_the_squared_actions_and_the_penalty_paid():
+    """2 action dimensions at |a| = 1 for 10 steps at c = 0.5: sum(a^2) = 20, and the agent paid 0.5 * 20 = 10."""
+    from sb3_gqn.common.evaluation import growth_columns, rollout_figures
+    from sb3_gqn.common.wrappers import ActionPenalty
+    from sb3_gqn.experiments.runs import COLUMNS, curve_row
+    from sb3_gqn.experiments.variants import RunSpec
+    from tests.test_metrics import FullThrottle, TwoDimensionalEnv
+
+    figures = rollout_figures(FullThrottle(), ActionPenalty(TwoDimensionalEnv(), coef=0.5), n_episodes=1)
+    evaluation = {"step": 10, "train_seconds": 1.0, **figures.as_dict(), **growth_columns(object())}
+    row = curve_row(RunSpec("sac", "Pendulum-v1", 0.5, 0, 10), evaluation)
+    assert list(row) == COLUMNS and "action_penalty" not in row
+    assert (row["action_squares"], row["penalty_paid"]) == (20.0, 10.0)
+    assert row["task_return"] - row["return"] == row["penalty_paid"]
+
+
+def _earlier_release_rows(penalty: float, squares: float) -> list[dict]:
+    """A run's rows as an earlier release wrote them: the squared actions under ``action_penalty``."""
+    return [_row("gqn-adaptive", 0, step, 200.0) | {"penalty": penalty, "action_penalty": squares} for step in (100, 200)]
+
+
+def test_an_earlier_releases_action_penalty_is_read_as_the_squared_actions(tmp_path, capsys):
+    """Earlier tables held sum(a^2) under action_penalty: at c = 0.1, 147 there is 14.7 paid."""
+    from sb3_gqn.experiments.scores import with_action_columns
+
+    earlier = pd.DataFrame(_earlier_release_rows(0.1, 147.0))
+    read = with_action_columns(earlier)
+    assert "action_penalty" not in read.columns
+    assert read["action_squares"].tolist() == [147.0, 147.0]
+    assert read["penalty_paid"].tolist() == pytest.approx([14.7, 14.7])
+    today = read.copy()
+    assert with_action_columns(today) is today  # a table of today's columns is read as it is
+    # the report's P is the penalty paid, whichever release wrote the table
+    line = "| cartpole-swingup-v0 | gqn-adaptive | 0 | 200 | 200 | 210 | 14.70 | 0.10 | 0.0100 | 9 | 2.00 |"
+    assert line in report(earlier, reps=10)
+    for name, table in (("earlier.csv", earlier), ("today.csv", today)):
+        table.to_csv(tmp_path / name, index=False)
+        assert main([str(tmp_path / name), "--reps", "10"]) == 0
+        out = capsys.readouterr().out
+        assert line in out and "P: the action penalty paid over an episode, c·Σa²" in out
+
+
+def test_the_runner_carries_an_earlier_releases_rows_over_to_todays_columns(tmp_path):
+    import csv
+
+    from sb3_gqn.experiments.runs import COLUMNS, append_row, collect, upgraded_row
+    from sb3_gqn.experiments.variants import RunSpec
+
+    assert upgraded_row({"penalty": "0.5", "action_penalty": "20", "seed": "0"}) == {
+        "penalty": "0.5",
+        "seed": "0",
+        "action_squares": "20",
+        "penalty_paid": 10.0,
+    }
+    assert upgraded_row({"penalty": "0.5", "action_penalty": ""})["penalty_paid"] == ""
+    earlier = [column if column != "action_squares" else "action_penalty" for column in COLUMNS if column != "penalty_paid"]
+    old_rows = [{**dict.fromkeys(earlier, ""), **row} for row in _earlier_release_rows(0.5, 20.0)]
+    # a curve begun by an earlier release continues under today's header
+    curve = tmp_path / "curve.csv"
+    with open(curve, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=earlier)
+        writer.writeheader()
+        writer.writerow(old_rows[0])
+    append_row(curve, dict.fromkeys(COLUMNS, "1"))
+    with open(curve, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [(row["action_squares"], row["penalty_paid"]) for row in rows] == [("20.0", "10.0"), ("1", "1")]
+    # a committed table of an earlier release, extended by a later invocation, keeps its runs' figures
+    with open(tmp_path / "results.csv", "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=earlier)
+        writer.writeheader()
+        writer.writerows(old_rows)
+    collect([RunSpec("sac", "Pendulum-v1", 0.5, 0, 200)], tmp_path)
+    with open(tmp_path / "results.csv", newline="") as handle:
+        reader = csv.DictReader(handle)
+        rows = list(reader)
+    assert reader.fieldnames == COLUMNS
+    assert [(row["action_squares"], row["penalty_paid"]) for row in rows] == [("20.0", "10.0")] * 2

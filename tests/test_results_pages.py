@@ -58,7 +58,7 @@ def humanoid_rows() -> list[dict]:
     humanoid = {"env": HUMANOID, "growth_fractions": "0.300:3"}
     rows = [evaluation("gqn-paper", seed, 200_000, -5.0, **humanoid, task_return=71.0) for seed in (0, 1)]
     for seed, task_return, penalty, magnitude in ((0, 7.0, 840.0, 0.1), (1, 71.0, 1890.0, 0.2)):
-        final = {"task_return": task_return, "action_penalty": penalty, "action_magnitude": magnitude}
+        final = {"task_return": task_return, "action_squares": penalty, "action_magnitude": magnitude}
         rows.append(evaluation("gqn-paper", seed, 1_000_000, -400.0, **humanoid, **final))
     return rows + [evaluation("decqn-paper-2", 1, step, -1.0, env=HUMANOID) for step in (200_000, 400_000)]
 

@@ -102,3 +102,28 @@ def test_the_report_refuses_a_missing_variants_file_and_no_repetitions(tmp_path,
     with pytest.raises(SystemExit):
         report([str(table), "--reps", "0"])
     assert "--reps must be >= 1, got 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("spelling", ["sbx-sac", "sbx_sac"])
+def test_the_runner_takes_sbx_sac_in_either_spelling(spelling, tmp_path, capsys):
+    """``sbx_sac`` is how ``sb3-gqn train --algo`` names SBX's SAC: the runner takes it for its agent ``sbx-sac``."""
+    assert runner.parse_args(["--algos", spelling, "sac"]).algos == ["sbx-sac", "sac"]
+    options = ["--algos", spelling, "--envs", "Pendulum-v1", "--penalties", "0.1", "--seeds", "0", "--steps", "2000"]
+    assert benchmark([*options, "--list", "--out", str(tmp_path / "out")]) == 0
+    assert "pending sbx-sac__Pendulum-v1__c0.1__seed0 (2000 steps)" in capsys.readouterr().out
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unknown_agent_is_refused_with_every_agent_there_is(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        benchmark(["--algos", "sbx", "--out", str(tmp_path / "out")])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert "argument --algos: invalid choice: 'sbx'" in err and "sbx-sac" in err and "gqn-adaptive" in err
+
+
+def test_a_variants_file_may_name_sbx_sac_as_the_runner_does(tmp_path):
+    from sb3_gqn.experiments.variants import load_variants
+
+    (tmp_path / "variants.yml").write_text("sbx-sac+fast:\n  algo: sbx-sac\n  hyperparams: {train_freq: 2}\n")
+    assert load_variants(tmp_path / "variants.yml")["sbx-sac+fast"].algo == "sbx_sac"

@@ -61,3 +61,25 @@ def test_sb3_gqn_train_runs_sbx_sac(tmp_path):
 
     assert train(["--algo", "sbx_sac", "--env", "Pendulum-v1", "-n", "1100", "-f", str(tmp_path), "--seed", "0"]) == 0
     assert list((tmp_path / "sbx_sac").glob("Pendulum-v1_1/Pendulum-v1.zip"))
+
+
+@pytest.mark.parametrize("spelling", ["sbx_sac", "sbx-sac"])
+def test_sb3_gqn_train_takes_sbx_sac_in_either_spelling(spelling, monkeypatch):
+    """``sbx-sac`` is how ``sb3-gqn benchmark`` names SBX's SAC: ``sb3-gqn train`` hands rl-zoo3 its own spelling,
+    with SAC's hyperparameter file (rl-zoo3's experiment manager stands in: nothing trains)."""
+    import rl_zoo3.train
+
+    from sb3_gqn.zoo.cli import train
+
+    made = []
+
+    class Recorded:
+        def __init__(self, args, algo, *rest, **kwargs):
+            made.append((algo, kwargs["config"]))
+
+        def setup_experiment(self):
+            return None, {}  # no model: rl-zoo3 trains nothing
+
+    monkeypatch.setattr(rl_zoo3.train, "ExperimentManager", Recorded)
+    assert train(["--algo", spelling, "--env", "Pendulum-v1", "-n", "10"]) == 0
+    assert made == [("sbx_sac", str(shipped_hyperparams("sac")))]

@@ -68,5 +68,5 @@ def test_a_missing_sac_entry_prints_sacs_template(capsys, tmp_path):
     error = capsys.readouterr().err
     assert "Hyperparameters not found for sac-Reacher-v5" in error
     assert "learning_starts: 10000" in error and "bins:" not in error
-    # Reacher-v5's reward has its own control cost (reward_control_weight 0.1): no ActionPenalty on top
-    assert "ActionPenalty" not in error and "0.1 * sum(a^2)" in error
+    # Reacher-v5's reward has its own control cost (reward_control_weight 1): no ActionPenalty on top
+    assert "ActionPenalty" not in error and "(1 * sum(a^2)) is the action penalty" in error

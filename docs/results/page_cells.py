@@ -51,7 +51,7 @@ def difference_cell(values_x: np.ndarray, values_y: np.ndarray) -> str:
 
 
 #: the numeric columns of a results table that the pages read (an empty table has them too)
-NUMBER_COLUMNS = ["penalty", "seed", "step", "return", "task_return", "action_penalty", "action_magnitude"]
+NUMBER_COLUMNS = ["penalty", "seed", "step", "return", "task_return", "action_squares", "penalty_paid", "action_magnitude"]
 NUMBER_COLUMNS += ["smoothness", "episode_length", "wall_time"]
 
 

@@ -197,8 +197,8 @@ def growth_block(table: pd.DataFrame | None) -> str:
 
 def rms_action(runs: pd.DataFrame, dimensions: int) -> np.ndarray:
     """Each run's root-mean-square action over its final evaluation's steps and action dimensions, from the action
-    penalty column (``sum_t sum_j a_j^2``, the mean over episodes) and the mean episode length."""
-    return np.sqrt(runs["action_penalty"].to_numpy(float) / (runs["episode_length"].to_numpy(float) * dimensions))
+    squared actions (``action_squares``: ``sum_t sum_j a_j^2``, the mean over episodes) and the mean episode length."""
+    return np.sqrt(runs["action_squares"].to_numpy(float) / (runs["episode_length"].to_numpy(float) * dimensions))
 
 
 def humanoid_block(table: pd.DataFrame | None) -> str:

@@ -233,6 +233,7 @@ def rebuild(page: Path = RESULTS / "paper-scale.md") -> None:
         return
     plan = load([PAPER_SCALE / "results.csv"])
     replace_block(page, "paper-scale", paper_scale_block(plan))
-    figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE)
+    # the page reads each run with both decodings: its figures draw the paired readings too ("(relative)", dashed)
+    figures = plot_suite(PAPER_SCALE / "results.csv", PAPER_SCALE, paired=True)
     replace_block(page, "paper-scale-figures", figures_block(figures, page.parent))
     replace_block(page, "paper-scale-probes", probes_block(probe_runs(), plan))

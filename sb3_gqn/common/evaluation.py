@@ -121,7 +121,16 @@ def evaluate(
 
 
 #: the per-episode fields of SmoothnessFigures that rollout_figures averages, in the class's order
-_MEAN_FIELDS = ("task_return", "penalty", "action_magnitude", "action_change", "smoothness", "return_", "episode_length")
+_MEAN_FIELDS = (
+    "task_return",
+    "action_squares",
+    "penalty_paid",
+    "action_magnitude",
+    "action_change",
+    "smoothness",
+    "return_",
+    "episode_length",
+)
 
 
 def rollout_figures(
@@ -146,10 +155,8 @@ def rollout_figures(
     means = np.mean([[getattr(figure, name) for name in _MEAN_FIELDS] for figure in figures], axis=0)
     flags = [figure.success for figure in figures if not math.isnan(figure.success)]
     success = float(np.mean(flags)) if flags else math.nan
-    task_return, penalty, magnitude, change, smoothness, return_, length = (float(mean) for mean in means)  # _MEAN_FIELDS
-    return SmoothnessFigures(
-        task_return, penalty, magnitude, change, smoothness, return_, length, float(freq), n_episodes, success
-    )
+    averaged = {name: float(mean) for name, mean in zip(_MEAN_FIELDS, means)}
+    return SmoothnessFigures(**averaged, freq=float(freq), episodes=n_episodes, success=success)
 
 
 def growth_columns(model: Any) -> dict[str, Any]:

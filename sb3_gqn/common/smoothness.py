@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -114,17 +115,22 @@ def normalized_actions(actions: np.ndarray, action_space: spaces.Box) -> np.ndar
 class SmoothnessFigures:
     """Figure 4's metrics for greedy rollouts, each the mean over episodes.
 
-    ``task_return`` R (without the action penalty), ``penalty`` P (the action cost ``sum_t sum_j a_j^2``
-    of the rescaled actions, i.e. the penalty with ``c = 1``; the reward lost to an ``ActionPenalty(c)``
-    is ``c * P``), ``action_magnitude`` ``|a|`` (mean of ``|a_j|``), ``action_change`` ``|Δa|`` (mean of
-    ``|a_j(t) - a_j(t-1)|``), ``smoothness`` SM (:func:`smoothness` per episode), ``return_`` the
-    return the agent was trained on (penalized if the env is), the sampling frequency used, and ``success``: the
-    share of episodes whose final step the task flagged as solved (Meta-World's ``info["success"]``, MyoSuite's
-    ``info["solved"]``), NaN for tasks without such a flag.
+    ``task_return`` R (without the action penalty); ``action_squares`` ``Σa²``, the squared rescaled actions summed over
+    the episode's steps and dimensions (``sum_t sum_j a_j^2``: the action penalty at ``c = 1``); ``penalty_paid`` the
+    reward an :class:`~sb3_gqn.common.wrappers.ActionPenalty` took over the episode, ``c * Σa²`` (its
+    ``info["action_penalty"]`` summed; 0 on an env without one); ``action_magnitude`` ``|a|`` (mean of ``|a_j|``),
+    ``action_change`` ``|Δa|`` (mean of ``|a_j(t) - a_j(t-1)|``), ``smoothness`` SM (:func:`smoothness` per episode),
+    ``return_`` the return the agent was trained on (penalized if the env is), the sampling frequency used, and
+    ``success``: the share of episodes whose final step the task flagged as solved (Meta-World's ``info["success"]``,
+    MyoSuite's ``info["solved"]``), NaN for tasks without such a flag.
+
+    Two action dimensions at ``|a| = 1`` for 10 steps under ``ActionPenalty(coef=0.5)``: ``action_squares`` 20,
+    ``penalty_paid`` 10.
     """
 
     task_return: float
-    penalty: float
+    action_squares: float
+    penalty_paid: float
     action_magnitude: float
     action_change: float
     smoothness: float
@@ -137,13 +143,26 @@ class SmoothnessFigures:
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    @property
+    def penalty(self) -> float:
+        """Deprecated: :attr:`action_squares` (``Σa²``, which this name held); the penalty paid is
+        :attr:`penalty_paid`."""
+        warnings.warn(
+            "SmoothnessFigures.penalty is action_squares (the squared actions summed, the penalty at c = 1); "
+            "the penalty paid is penalty_paid",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.action_squares
+
 
 def episode_figures(episode: Episode, freq: float) -> SmoothnessFigures:
     """:class:`SmoothnessFigures` of one episode (``episodes=1``), SM at sampling frequency ``freq``."""
     scaled = episode.actions
     return SmoothnessFigures(
         task_return=episode.task_return,
-        penalty=float((scaled**2).sum()),
+        action_squares=float((scaled**2).sum()),
+        penalty_paid=episode.penalty,
         action_magnitude=float(np.abs(scaled).mean()),
         action_change=float(np.abs(np.diff(scaled, axis=0)).mean()) if len(scaled) > 1 else 0.0,
         smoothness=smoothness(scaled, freq) if len(scaled) > 1 else 0.0,

@@ -9,7 +9,8 @@
 
 Prints, from the tables alone (no model files needed, so committed tables are enough):
 
-* the final greedy evaluation of every run (return, task return, P, mean action change, SM, bins, training seconds);
+* the final greedy evaluation of every run (return, task return, P: the action penalty paid over an episode, c·Σa²,
+  mean action change, SM, bins, training seconds);
 * per algorithm and task, the mean final return and SM over seeds;
 * the growth check of every GQN run: for each growth event, the last evaluation of the policy before it and
   the first after it that the growth can have changed (growth_checks), and whether the return held
@@ -40,6 +41,7 @@ from sb3_gqn.experiments.scores import (
     normalized_final_runs,
     normalized_final_scores,
     run_growth_events,
+    with_action_columns,
     with_paired_readings,
 )
 from sb3_gqn.experiments.significance import (
@@ -159,7 +161,8 @@ REQUIRED_COLUMNS = ("algo", "env", "penalty", "seed", "step", "return")
 
 
 def read_table(path: Path) -> pd.DataFrame:
-    """One results table.
+    """One results table, under today's columns (:func:`~sb3_gqn.experiments.scores.with_action_columns`), with its
+    paired readings as agents of their own (:func:`~sb3_gqn.experiments.scores.with_paired_readings`).
 
     :raises ValueError: naming the file when it is empty, not CSV, or lacks a column of :data:`REQUIRED_COLUMNS`
     """
@@ -172,7 +175,7 @@ def read_table(path: Path) -> pd.DataFrame:
         raise ValueError(f"{path} is not a results table: it lacks the columns {missing}")
     if table.empty:
         raise ValueError(f"{path} holds no runs (a header without rows)")
-    return with_paired_readings(table)
+    return with_paired_readings(with_action_columns(table))
 
 
 def load(paths: list[Path]) -> pd.DataFrame:
@@ -306,6 +309,7 @@ def report_sections(
     or more) and, for ``pairs``, ``comparison_tasks`` and ``comparison_per_task`` where the table has them.
     ``max_runs`` caps the IQM's runs per task and agent (its lowest seeds); the "every run" columns pool them all.
     ``variants``: the agents the table's runs trained (:func:`growth_checks`)."""
+    table = with_action_columns(table)
     final = final_rows(table).sort_values(["env", "penalty", "algo", "seed"])
     sections: dict[str, Section] = {}
     columns = {
@@ -315,7 +319,7 @@ def report_sections(
         "step": "step",
         "return": "return",
         "task_return": "task return",
-        "action_penalty": "P",
+        "penalty_paid": "P",
         "action_change": "\\|Δa\\|",  # escaped: a bare | splits a markdown cell
         "smoothness": "SM",
         "active_bins": "bins",
@@ -324,7 +328,8 @@ def report_sections(
     shown = final[list(columns)].rename(columns=columns)
     shown["env"] = shown["env"].str.replace("dm_control/", "", regex=False)
     shown["bins"] = shown["bins"].map(lambda bins: "-" if pd.isna(bins) else str(int(bins)))
-    sections["final"] = Section("Final greedy evaluation per run", _markdown(shown))
+    heading = "Final greedy evaluation per run (P: the action penalty paid over an episode, c·Σa²)"
+    sections["final"] = Section(heading, _markdown(shown))
 
     means = final.groupby(["env", "penalty", "algo"]).agg(
         seeds=("seed", "count"), mean_return=("return", "mean"), mean_SM=("smoothness", "mean")

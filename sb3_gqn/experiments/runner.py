@@ -43,7 +43,15 @@ from sb3_gqn.experiments.runs import (
     run,
     runs_in_progress,
 )
-from sb3_gqn.experiments.variants import FULL_SUITE, SHORT_SUITE, RunSpec, load_variants, untrained_runs, with_variants_files
+from sb3_gqn.experiments.variants import (
+    FULL_SUITE,
+    SHORT_SUITE,
+    RunSpec,
+    agent_name,
+    load_variants,
+    untrained_runs,
+    with_variants_files,
+)
 from sb3_gqn.zoo.hyperparams import penalized_env_ids
 
 
@@ -71,9 +79,11 @@ def parse_args(argv: Sequence[str] | None = None, prog: str | None = None) -> ar
     parser.add_argument(
         "--algos",
         nargs="+",
+        type=lambda name: agent_name(name, agents),  # sbx_sac, rl-zoo3's spelling, is sbx-sac
         choices=list(agents),
         metavar="AGENT",
-        help=f"agents: {', '.join(agents)} (default: {' '.join(SHORT_SUITE['algos'])})",
+        help=f"agents: {', '.join(agents)} (sbx-sac also as sbx_sac, as sb3-gqn train --algo names it; "
+        f"default: {' '.join(SHORT_SUITE['algos'])})",
     )
     parser.add_argument("--envs", nargs="+", help=f"env ids with an entry in the shipped files; default {SHORT_SUITE['envs']}")
     parser.add_argument("--penalties", nargs="+", type=float, help="action penalty coefficients c")

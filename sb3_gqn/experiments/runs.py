@@ -33,7 +33,9 @@ from sb3_gqn.experiments.checkpoints import (
 from sb3_gqn.experiments.variants import RunSpec, make_eval_env, run_overrides, run_wrappers
 from sb3_gqn.zoo.hyperparams import shipped_hyperparams
 
-#: Columns of results.csv, in order
+#: Columns of results.csv, in order. ``action_squares`` is ``Σa²``, the rescaled actions squared and summed over an
+#: evaluation episode (mean over its episodes); ``penalty_paid`` the reward the run's ``ActionPenalty`` took over an
+#: episode, ``penalty * action_squares`` (tables of earlier releases: :func:`upgraded_row`)
 COLUMNS = [
     "algo",
     "env",
@@ -42,7 +44,8 @@ COLUMNS = [
     "step",
     "return",
     "task_return",
-    "action_penalty",
+    "action_squares",
+    "penalty_paid",
     "action_magnitude",
     "action_change",
     "smoothness",
@@ -109,7 +112,8 @@ def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
         "step": row["step"],
         "return": row["return_"],
         "task_return": row["task_return"],
-        "action_penalty": row["penalty"],
+        "action_squares": row["action_squares"],
+        "penalty_paid": row["penalty_paid"],
         "action_magnitude": row["action_magnitude"],
         "action_change": row["action_change"],
         "smoothness": row["smoothness"],
@@ -126,6 +130,28 @@ def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+#: the column in which tables of earlier releases held ``Σa²`` (today's ``action_squares``): the penalty at c = 1, not
+#: the penalty paid its name suggested
+EARLIER_SQUARES_COLUMN = "action_penalty"
+
+
+def upgraded_row(row: dict[str, Any]) -> dict[str, Any]:
+    """A row of a table or curve an earlier release wrote, under today's columns (a row of today's, unchanged).
+
+    Earlier releases wrote ``Σa²`` under ``action_penalty``: it becomes ``action_squares``, and ``penalty_paid`` is the
+    row's ``penalty`` times it (``penalty`` 0.5 and ``action_penalty`` 20: ``action_squares`` 20, ``penalty_paid``
+    10). An empty ``action_penalty`` leaves both empty.
+    """
+    if EARLIER_SQUARES_COLUMN not in row or "action_squares" in row:
+        return row
+    upgraded = {key: value for key, value in row.items() if key != EARLIER_SQUARES_COLUMN}
+    squares = row[EARLIER_SQUARES_COLUMN]
+    upgraded["action_squares"] = squares
+    blank = squares is None or str(squares).strip() == ""
+    upgraded["penalty_paid"] = "" if blank else float(row["penalty"]) * float(squares)
+    return upgraded
+
+
 def append_row(path: Path, row: dict[str, Any]) -> None:
     """Append one :data:`COLUMNS` row to the csv file ``path`` (with the header when the file is new; a file an
     earlier release began, with fewer columns, is rewritten under today's header first)."""
@@ -138,7 +164,7 @@ def append_row(path: Path, row: dict[str, Any]) -> None:
             with open(path, "w", newline="") as handle:
                 writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")
                 writer.writeheader()
-                writer.writerows({column: old.get(column, "") for column in COLUMNS} for old in earlier)
+                writer.writerows({column: upgraded_row(old).get(column, "") for column in COLUMNS} for old in earlier)
     with open(path, "a", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=COLUMNS)
         if handle.tell() == 0:
@@ -358,14 +384,15 @@ def recorded_rows(table: Path) -> RecordedRuns:
     """Rows of an existing ``results.csv`` grouped by run (algo, env, penalty, seed); empty if there is none.
 
     Committed tables are how a later invocation (or another machine) extends a suite: a run recorded there up to its
-    budget counts as finished even when its ``runs/`` folder is gone.
+    budget counts as finished even when its ``runs/`` folder is gone. Rows of an earlier release come under today's
+    columns (:func:`upgraded_row`).
     """
     if not table.is_file():
         return {}
     runs: RecordedRuns = {}
     with open(table, newline="") as handle:
         for row in csv.DictReader(handle):
-            runs.setdefault(_run_key(row), []).append(row)
+            runs.setdefault(_run_key(row), []).append(upgraded_row(row))
     return runs
 
 
@@ -394,7 +421,7 @@ def collect(specs: list[RunSpec], out: Path) -> Path:
             curve = out / "runs" / spec.name / "curve.csv"
             if (out / "runs" / spec.name / "done.json").is_file() and curve.is_file():
                 with open(curve, newline="") as rows:
-                    rows_by_run[spec.key] = list(csv.DictReader(rows))
+                    rows_by_run[spec.key] = [upgraded_row(row) for row in csv.DictReader(rows)]
         scratch = table.with_suffix(f".csv.{os.getpid()}.tmp")
         with open(scratch, "w", newline="") as handle:
             writer = csv.DictWriter(handle, fieldnames=COLUMNS, restval="")

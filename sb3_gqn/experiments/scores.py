@@ -9,19 +9,53 @@ import pandas as pd
 from sb3_gqn.experiments.significance import seeded_numpy_global_generator
 
 
+def with_action_columns(table: pd.DataFrame) -> pd.DataFrame:
+    """The table under today's action columns: a table of an earlier release held ``Σa²`` (the squared actions summed
+    over the episode: the penalty at c = 1) under ``action_penalty``; it becomes ``action_squares``, and
+    ``penalty_paid``, the penalty the agent paid, is each row's ``penalty`` times it (see
+    :func:`~sb3_gqn.experiments.runs.upgraded_row`). Today's tables, and tables without the column, are unchanged."""
+    if "action_penalty" not in table.columns or "action_squares" in table.columns:
+        return table
+    upgraded = table.rename(columns={"action_penalty": "action_squares"})
+    upgraded.insert(
+        list(upgraded.columns).index("action_squares") + 1,
+        "penalty_paid",
+        upgraded["penalty"] * upgraded["action_squares"],
+    )
+    return upgraded
+
+
+def _decodings(table: pd.DataFrame) -> pd.Series:
+    """Each row's ``decoding``: ``""`` for a run's own decoding (and for every row of a table without the column)."""
+    if "decoding" not in table.columns:
+        return pd.Series("", index=table.index, dtype=object)
+    return table["decoding"].fillna("").astype(str)
+
+
+def readings(table: pd.DataFrame, paired: bool = False) -> pd.DataFrame:
+    """The rows a figure draws, each with the column ``agent``: the agent whose run it reads, which gives its colour.
+
+    Each run's own decoding (the rows with an empty ``decoding``), under its agent's name; with ``paired``, also its
+    paired readings (the rows whose ``decoding`` names the decoding that read the run's model beside its own, see
+    :data:`~sb3_gqn.experiments.runs.PAIRED_DECODING`), each under ``agent (decoding)``, e.g. ``gqn-linear
+    (relative)``. A table whose paired rows :func:`with_paired_readings` already named so gives the same rows.
+    """
+    decoding = _decodings(table)
+    names = table["algo"].astype(str)
+    agents = [name.removesuffix(f" ({kind})") if kind else name for name, kind in zip(names, decoding)]
+    labelled = table.assign(agent=agents)
+    labelled["algo"] = [f"{agent} ({kind})" if kind else agent for agent, kind in zip(agents, decoding)]
+    return labelled if paired else labelled[(decoding == "").to_numpy()]
+
+
 def with_paired_readings(table: pd.DataFrame) -> pd.DataFrame:
     """The table with every paired reading (a row whose ``decoding`` names the decoding that read the run's model
     beside its own, see :data:`~sb3_gqn.experiments.runs.PAIRED_DECODING`) as an agent of its own, ``algo (decoding)``:
-    every table and figure then shows a run's two decodings side by side. Tables without the column are unchanged."""
+    the report's tables then show a run's two decodings side by side. Tables without the column are unchanged, and so
+    is a table whose paired readings are named so already."""
     if "decoding" not in table.columns:
         return table
-    decoding = table["decoding"].fillna("").astype(str)
-    paired = decoding != ""
-    if not paired.any():
-        return table
-    labelled = table.copy()
-    labelled.loc[paired, "algo"] = labelled.loc[paired, "algo"].astype(str) + " (" + decoding[paired] + ")"
-    return labelled
+    return readings(table, paired=True).drop(columns="agent")
 
 
 def run_growth_events(runs: pd.DataFrame, column: str = "growth_events") -> list[tuple[int, int]]:
@@ -41,14 +75,17 @@ def final_rows(table: pd.DataFrame) -> pd.DataFrame:
     return table[table["step"] == last]
 
 
-def normalized_final_runs(table: pd.DataFrame) -> tuple[dict[str, list[np.ndarray]], list[tuple[str, float]]]:
+def normalized_final_runs(
+    table: pd.DataFrame, normalize: bool = True
+) -> tuple[dict[str, list[np.ndarray]], list[tuple[str, float]]]:
     """Final returns min-max normalized per task (env, penalty) over all of that task's runs: ``{algo: [runs of
-    each task]}`` (every run, counts may differ between tasks) and the tasks."""
+    each task]}`` (every run, counts may differ between tasks) and the tasks; the final returns as they are with
+    ``normalize=False``."""
     final = final_rows(table).copy()
     task_range = final.groupby(["env", "penalty"])["return"].agg(["min", "max"])
     final = final.join(task_range, on=["env", "penalty"])
     spread = (final["max"] - final["min"]).replace(0.0, 1.0)
-    final["normalized"] = (final["return"] - final["min"]) / spread
+    final["normalized"] = (final["return"] - final["min"]) / spread if normalize else final["return"]
     final = final.sort_values("seed", kind="stable")  # lowest seeds first, so a cut keeps the same seeds everywhere
     tasks = sorted(set(zip(final["env"], final["penalty"])))
     runs_by_algo = {
@@ -78,6 +115,19 @@ def normalized_final_scores(
     """:func:`normalized_final_runs` cut by :func:`equal_run_scores` (``max_runs``: see there), and the tasks."""
     runs_by_algo, tasks = normalized_final_runs(table)
     return equal_run_scores(runs_by_algo, max_runs), tasks
+
+
+def iqm_scores(
+    table: pd.DataFrame, max_runs: int | None = None
+) -> tuple[dict[str, np.ndarray], list[tuple[str, float]], bool]:
+    """What the IQM figure reads, cut as :func:`equal_run_scores` cuts (``max_runs``: see there), the tasks, and
+    whether the scores are normalized: across two tasks or more the min-max normalized final returns
+    (:func:`normalized_final_scores`); on one task the final returns as they are, since min-max normalizing one task
+    over the agents drawn scores the worst 0 and the best 1 whatever their returns (-1276, -1185 and -906 would read
+    0, 0.25 and 1)."""
+    normalize = final_rows(table).groupby(["env", "penalty"]).ngroups >= 2
+    runs_by_algo, tasks = normalized_final_runs(table, normalize)
+    return equal_run_scores(runs_by_algo, max_runs), tasks, normalize
 
 
 def degenerate_tasks(table: pd.DataFrame) -> list[tuple[str, float]]:

@@ -7,7 +7,7 @@ A variants file (YAML) names further agents, each as the rl-zoo3 algorithm it tr
 over that algorithm's shipped entry::
 
     gqn-adaptive+twin:                 # the name the runner's --algos and results.csv use
-      algo: gqn                        # gqn, decqn, sac, td3 or sbx_sac: whose shipped entry it starts from
+      algo: gqn                        # gqn, decqn, sac, td3 or sbx_sac (sbx-sac): whose shipped entry it starts from
       hyperparams: {growth: adaptive}  # set over the entry (rl-zoo3's format: policy_kwargs as source text)
       add_policy_kwargs: n_critics=2   # optional: keyword arguments added to the entry's policy_kwargs
       env_hyperparams:                 # optional: per env, set over the entry before ``hyperparams``
@@ -70,6 +70,15 @@ VARIANTS: Mapping[str, Variant] = MappingProxyType(
 ZOO_ALGOS = ("gqn", "decqn", "sac", "td3", "sbx_sac")
 
 
+def agent_name(name: str, agents: Iterable[str] = VARIANTS) -> str:
+    """The runner's spelling of agent ``name``: with hyphens where rl-zoo3's algorithm names have underscores
+    (``sbx_sac``, as ``sb3-gqn train --algo`` takes it, is the agent ``sbx-sac``), when that spelling is one of
+    ``agents``; any other name as given."""
+    names = set(agents)
+    hyphenated = name.replace("_", "-")
+    return hyphenated if name not in names and hyphenated in names else name
+
+
 def load_variants(path: str | Path, known: Mapping[str, Variant] = VARIANTS) -> dict[str, Variant]:
     """Read a variants file (format in the module's docstring): its agents, by name. Nothing global changes: pass
     them (with the shipped ones, :func:`with_variants_files`) to what runs or reads them.
@@ -82,13 +91,14 @@ def load_variants(path: str | Path, known: Mapping[str, Variant] = VARIANTS) -> 
     loaded = {}
     for name, entry in read_entries(path).items():
         unknown = set(entry) - {"algo", "hyperparams", "add_policy_kwargs", "env_hyperparams", "add_env_wrappers"}
-        if entry.get("algo") not in ZOO_ALGOS or unknown:
+        algo = str(entry.get("algo")).replace("-", "_")  # sbx-sac, the runner's agent name, is rl-zoo3's sbx_sac
+        if algo not in ZOO_ALGOS or unknown:
             raise ValueError(
                 f"{path}: variant {name!r} needs 'algo' (one of {ZOO_ALGOS}) and only the keys hyperparams, "
                 f"add_policy_kwargs, env_hyperparams, add_env_wrappers; got {sorted(entry)}"
             )
         variant = Variant(
-            entry["algo"],
+            algo,
             dict(entry.get("hyperparams") or {}),
             entry.get("add_policy_kwargs"),
             {env: dict(values or {}) for env, values in (entry.get("env_hyperparams") or {}).items()},

@@ -10,8 +10,9 @@ hyperparameter files as defaults (``sb3-gqn train|enjoy|record-video``).
 Every rl-zoo3 flag works, plus ``--n-envs N`` (short for ``-params n_envs:N``) and ``--preset NAME`` (a named
 configuration of :mod:`sb3_gqn.common.presets`, set over the env's entry). Without ``-conf`` the algorithms the
 project ships a file for (gqn, decqn, sac, td3) read ``sb3_gqn/zoo/hyperparams/<algo>.yml``, SBX's SAC (``--algo
-sbx_sac``, the ``sbx`` extra) reads SAC's; the others read rl-zoo3's own files. ``-optimize`` without ``--storage``
-keeps the study in ``<log folder>/<algo>/optuna.db`` (SQLite) under the name ``<algo>_<env>``. ``enjoy`` and
+sbx_sac``, or ``sbx-sac`` as ``sb3-gqn benchmark`` names it; the ``sbx`` extra) reads SAC's; the others read rl-zoo3's
+own files. An ``--algo`` that is no algorithm is refused with the list of those there are. ``-optimize`` without
+``--storage`` keeps the study in ``<log folder>/<algo>/optuna.db`` (SQLite) under the name ``<algo>_<env>``. ``enjoy`` and
 ``record_video`` load the agent without a replay buffer (``buffer_size=1``). ``MUJOCO_GL`` defaults to ``disable``
 for training (it renders nothing).
 """
@@ -28,7 +29,7 @@ from typing import Any
 
 from sb3_gqn.common.presets import PRESET_NAMES, preset_algorithm, zoo_hyperparams
 from sb3_gqn.zoo.hyperparams import extended_hyperparams
-from sb3_gqn.zoo.registration import ZOO_ALGOS, loader_without_replay_memory, register
+from sb3_gqn.zoo.registration import ZOO_ALGOS, loader_without_replay_memory, register, zoo_algo_name, zoo_algorithms
 
 
 def _option_value(argv: Sequence[str], *names: str) -> str | None:
@@ -72,6 +73,31 @@ def default_train_arguments(argv: Sequence[str]) -> list[str]:
         if _option_value(argv, "--study-name") is None:
             argv += ["--study-name", f"{algo}_{env_id.replace('/', '-')}"]
     return argv
+
+
+def _with_zoo_algo_name(argv: list[str]) -> list[str]:
+    """``argv`` with every ``--algo`` value in rl-zoo3's spelling (:func:`~sb3_gqn.zoo.registration.zoo_algo_name`:
+    ``--algo sbx-sac``, the comparison runner's name, is ``--algo sbx_sac``)."""
+    spelled = list(argv)
+    for position, argument in enumerate(spelled):
+        if argument == "--algo" and position + 1 < len(spelled):
+            spelled[position + 1] = zoo_algo_name(spelled[position + 1])
+        elif argument.startswith("--algo="):
+            spelled[position] = "--algo=" + zoo_algo_name(argument.split("=", 1)[1])
+    return spelled
+
+
+def unknown_algo_error(argv: Sequence[str], prog: str) -> str | None:
+    """The error line for an ``--algo`` in ``argv`` that is no algorithm of
+    :func:`~sb3_gqn.zoo.registration.zoo_algorithms` (after :func:`_with_zoo_algo_name`), naming every one; ``None``
+    when there is none."""
+    algo = _option_value(argv, "--algo")
+    if algo is None or algo in zoo_algorithms():
+        return None
+    return (
+        f"{prog}: error: --algo {algo!r} is not an algorithm: the algorithms are {', '.join(zoo_algorithms())} "
+        "(sbx_sac, the sbx extra's SAC, also as sbx-sac)"
+    )
 
 
 def _without_option(argv: list[str], name: str) -> list[str]:
@@ -270,8 +296,9 @@ TRAIN_HELP = """\
 sb3-gqn train: rl-zoo3's train with gqn and decqn registered; every rl-zoo3 option below works.
 
 Without -conf/--conf-file, gqn, decqn, sac and td3 read the project's files, sb3_gqn/zoo/hyperparams/<algo>.yml
-(the same envs, penalties and budgets for all four); an env without an entry fails with an entry printed to start
-from. GQN's and DecQN's own arguments go through -params as Python expressions, over the entry's:
+(the same envs, penalties and budgets for all four), and sbx_sac (SBX's SAC, the sbx extra; also spelt sbx-sac, as
+sb3-gqn benchmark names it) reads SAC's; an env without an entry fails with an entry printed to start from.
+GQN's and DecQN's own arguments go through -params as Python expressions, over the entry's:
   -params bins:"(3, 9)" growth:"'adaptive'" growth_kwargs:"dict(patience=3, eval_freq=5000)" train_freq:2
   -params decoding:"'relative'" decoding_kwargs:"dict(temperature=0.5)" replay_buffer_kwargs:"dict(prioritized=False)"
 (bins, growth, growth_kwargs, exploration, acting_tau, decoding, decoding_kwargs, replay_buffer_kwargs, n_steps, ...:
@@ -286,18 +313,36 @@ rl-zoo3's options:
 """
 
 
+def _checked_arguments(argv: Sequence[str] | None, prog: str) -> list[str] | None:
+    """The command's arguments with ``--algo`` in rl-zoo3's spelling; ``None`` after printing the error for an
+    unknown algorithm (:func:`unknown_algo_error`)."""
+    given = _with_zoo_algo_name(list(sys.argv[1:] if argv is None else argv))
+    error = unknown_algo_error(given, prog)
+    if error is not None:
+        print(error, file=sys.stderr)
+        return None
+    return given
+
+
 def train(argv: Sequence[str] | None = None, prog: str = "sb3-gqn train") -> int:
-    """rl-zoo3's train with the project's algorithms and files; returns the exit code."""
+    """rl-zoo3's train with the project's algorithms and files; returns the exit code (2 for an ``--algo`` that is no
+    algorithm: the error names them all; ``sbx-sac``, the comparison runner's name, is ``sbx_sac``)."""
     os.environ.setdefault("MUJOCO_GL", "disable")  # training renders nothing: keep MuJoCo off any GL backend
-    given = list(sys.argv[1:] if argv is None else argv)
+    given = _checked_arguments(argv, prog)
+    if given is None:
+        return 2
     preset = _option_value(given, "--preset")
     algo = preset_algorithm(preset) if preset in PRESET_NAMES else _option_value(given, "--algo")
     register([algo])
-    return run_cli(_train, argv, prog=prog)
+    return run_cli(_train, given, prog=prog)
 
 
 def _replay(entry_point: Callable[[], Any], argv: Sequence[str] | None, prog: str) -> int:
-    register([_option_value(sys.argv[1:] if argv is None else argv, "--algo")])
+    given = _checked_arguments(argv, prog)
+    if given is None:
+        return 2
+    argv = given
+    register([_option_value(argv, "--algo")])
     from rl_zoo3 import utils
 
     utils.ALGOS.update({name: loader_without_replay_memory(algo) for name, algo in ZOO_ALGOS.items()})

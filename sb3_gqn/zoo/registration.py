@@ -24,6 +24,22 @@ ZOO_ALGOS: dict[str, type[GQN]] = {"gqn": GQN, "decqn": DecQN}
 SBX_ALGOS: dict[str, tuple[str, str]] = {"sbx_sac": ("sbx", "SAC")}
 
 
+def zoo_algorithms() -> list[str]:
+    """Every algorithm name ``sb3-gqn train --algo`` takes: rl-zoo3's own, the project's (:data:`ZOO_ALGOS`) and SBX's
+    (:data:`SBX_ALGOS`, also when the extra is not installed), sorted."""
+    from rl_zoo3.utils import ALGOS
+
+    return sorted({*ALGOS, *ZOO_ALGOS, *SBX_ALGOS})
+
+
+def zoo_algo_name(name: str) -> str:
+    """rl-zoo3's spelling of algorithm ``name``: with underscores where the comparison runner's agents have hyphens
+    (``sbx-sac`` is ``sbx_sac``), when that spelling is an algorithm of :func:`zoo_algorithms`; any other name as
+    given."""
+    underscored = name.replace("-", "_")
+    return underscored if name not in zoo_algorithms() and underscored in zoo_algorithms() else name
+
+
 def sbx_algorithm(name: str) -> type[Any]:
     """The SBX class of rl-zoo3 name ``name`` (:data:`SBX_ALGOS`).
 
