@@ -133,6 +133,8 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
     rate = ActionRatePenalty(gym.make("Pendulum-v1"))
     rate.reset(seed=0)
     model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, **tiny)
+    many_choices = DecliningEnv()
+    many_choices.action_space = gym.spaces.Discrete(2000)
     cases = {
         "bins must be an int >= 2 or an (initial, final) pair of ints, got '9'": lambda: GQN(
             "MlpPolicy", DecliningEnv(), bins="9"
@@ -141,9 +143,12 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         "bins=(2, 8) cannot be nested: doubling the intervals from 2 bins gives [2, 3, 5] then 9, never 8": lambda: GQN(
             "MlpPolicy", DecliningEnv(), bins=(2, 8)
         ),
-        "bins must be a single int >= 2 for DecQN, got (2, 9); use GQN for (initial, final) pairs": lambda: DecQN(
-            "MlpPolicy", DecliningEnv(), bins=(2, 9)
-        ),
+        "bins: at most MAX_BINS=1025 bins per action dimension (four doublings above the paper's finest, 65), got "
+        "1000000000": lambda: GQN("MlpPolicy", DecliningEnv(), bins=10**9),
+        "bins must be a single int from 2 to MAX_BINS=1025 for DecQN, got (2, 9); use GQN for (initial, final) "
+        "pairs": lambda: DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9)),
+        "the env's action space Discrete(2000) has 2000 choices per dimension: GQN and DecQN take at most "
+        "MAX_BINS=1025": lambda: GQN("MlpPolicy", many_choices),
         "bins=(3, 9) needs 9 choices per action dimension, but the env's action space Discrete(2) has 2: pass bins=2 "
         "(or a pair ending in it)": lambda: GQN("MlpPolicy", "CartPole-v1", bins=(3, 9)),
         "decoding_kwargs['temperature'] must be None or a number in [1.175e-38, 3.403e+38], float32's positive normal "

@@ -37,7 +37,13 @@ from sb3_gqn.common.torsos import SAVED_BEFORE_DEFAULT_TORSO, with_default_torso
 from sb3_gqn.gqn.acting import Acting, bin_grid, checked_decoding
 from sb3_gqn.gqn.growth.callback import with_growth_callback
 from sb3_gqn.gqn.growth.resolution import GrowingResolution
-from sb3_gqn.gqn.growth.schedules import bin_levels_from, checked_bins, default_bins, growth_settings
+from sb3_gqn.gqn.growth.schedules import (
+    bin_levels_from,
+    check_action_choices,
+    checked_bins,
+    default_bins,
+    growth_settings,
+)
 from sb3_gqn.gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.gqn.q_network import DecoupledQNetwork
 from sb3_gqn.gqn.saving import SavedFiles, upgrade_saved_settings
@@ -94,7 +100,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
     :param max_grad_norm: The maximum value for the gradient clipping (if None, no clipping)
     :param bins: bins per action dimension: an ``(initial, final)`` pair grows through the nested levels (``(3, 9)``:
         3, 5, 9; the paper's ``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. ``None``: ``(3, 9)`` for a
-        ``Box``, the env's own choices for a discrete space (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`)
+        ``Box``, the env's own choices for a discrete space (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`). At
+        most :data:`~sb3_gqn.gqn.growth.schedules.MAX_BINS` (1025, four doublings above the paper's finest 65) per
+        dimension, for ``bins`` and a discrete space's choices alike
     :param growth: ``"adaptive"`` (eq. 4 plus the plateau rule), ``"linear"`` (with ``N`` levels, level ``g`` opens
         after ``g / (N + 1)`` of ``total_timesteps``) or ``None`` (stay at the first level)
     :param growth_kwargs: the growth settings: ``init`` (``"interpolate"``: an opened bin's head row starts as the mean
@@ -196,6 +204,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         made_env = resolve_env(env)
         if made_env is not None:
             check_action_space(made_env.action_space)
+            check_action_choices(made_env.action_space)
             check_policy_fits(policy, made_env.observation_space)
             if bins is None:  # the env's own choices for a Discrete/MultiDiscrete space (default_bins)
                 bins, grows = default_bins(made_env.action_space)
@@ -232,6 +241,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         # load() sets the file's attributes and its own keyword arguments on the model before this runs: those of
         # earlier releases are moved where this one keeps them, and every setting is checked as the constructor does
         upgrade_saved_settings(self.__dict__)
+        check_action_choices(self.action_space)
         if self.bins is None:  # built without an env: the action space's default now
             self.bins, grows = default_bins(self.action_space)
             if not grows:
