@@ -187,3 +187,12 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
     for message, function in cases.items():
         assert message in raised(function), message
         assert message in table, message
+
+
+def test_the_gqn_page_quotes_the_line_auto_precision_says(monkeypatch):
+    from sb3_gqn.common import precision
+
+    monkeypatch.setattr(precision, "cpu_flags", lambda: frozenset({"avx512f", "avx512_bf16"}))
+    line = f"GQN: {precision.resolution_note('auto', 'cpu')}"
+    assert line == 'GQN: precision="auto" resolved to "bf16" (this CPU has AVX-512 BF16 matrix instructions)'
+    assert f"``{line}``" in flat("docs/modules/gqn.rst")

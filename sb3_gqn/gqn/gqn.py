@@ -31,7 +31,7 @@ from sb3_gqn.common.buffers import (
 from sb3_gqn.common.envs import check_action_space, check_policy_fits, resolve_env
 from sb3_gqn.common.finite import check_finite_observation
 from sb3_gqn.common.masking import EXPLORATION_MODES
-from sb3_gqn.common.precision import PRECISIONS, checked_precision, matmul_precision
+from sb3_gqn.common.precision import PRECISIONS, checked_precision, matmul_precision, resolution_note
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.common.torsos import SAVED_BEFORE_DEFAULT_TORSO, with_default_torso
 from sb3_gqn.gqn.acting import Acting, bin_grid, checked_decoding
@@ -118,7 +118,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         (:data:`~sb3_gqn.common.masking.DEFAULT_DECODING_TEMPERATURES`)
     :param precision: the arithmetic of the training updates' matrix products: ``"fp32"``; ``"bf16"``, bfloat16
         operands with float32 accumulation, weights and optimizer state; ``"auto"``: ``"bf16"`` where the device has
-        bfloat16 matrix units (:mod:`sb3_gqn.common.precision`). Acting, saved weights and the exports are float32
+        bfloat16 matrix units (AMX or AVX-512 BF16 CPUs, Ampere and later GPUs; with ``verbose >= 1`` the model says
+        what it resolved to; :mod:`sb3_gqn.common.precision`); the log records the result as ``train/precision``.
+        Acting, saved weights and the exports are float32
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -263,6 +265,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self._check_decoding()
         #: the precision the updates run in: ``precision`` with ``"auto"`` resolved for this device
         self.update_precision = checked_precision(self.precision, self.device)
+        note = resolution_note(self.precision, self.device)
+        if note is not None and self.verbose >= 1:
+            print(f"{type(self).__name__}: {note}")
         # a file whose policy_kwargs name no torso was built with the torso of its release (a model built here names it)
         self.policy_kwargs = with_default_torso(self.policy_kwargs, SAVED_BEFORE_DEFAULT_TORSO)
         # the policy keeps the averaged acting networks only when they are averaged (SB3 passes use_sde the same way)
@@ -400,6 +405,8 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
         )
         check_finite_observation(self._last_obs, "the env's reset")
+        # the arithmetic of this run's updates ("auto" resolved), a string: text in TensorBoard, a column in csv
+        self.logger.record("train/precision", self.update_precision)
         warn_if_learn_does_not_train(self.gradient_steps, total_timesteps, self.learning_starts)
         return total_timesteps, callback
 
