@@ -383,7 +383,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self.logger.record("train/q_mean", th.stack(q_values).mean().item())
         self.logger.record("growth/active_bins", self.active_bins)
         if prioritized is not None:
-            self.logger.record("replay/importance_sampling_exponent", prioritized.beta)
+            self.logger.record("replay/beta", prioritized.beta)
             self.logger.record("replay/max_priority", prioritized.max_priority)
 
     # ----------------------------------------------------------------------------------------------
