@@ -47,12 +47,12 @@ from sb3_gqn.gqn.growth.schedules import (
 from sb3_gqn.gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.gqn.q_network import DecoupledQNetwork
 from sb3_gqn.gqn.saving import SavedFiles, upgrade_saved_settings
-from sb3_gqn.gqn.settings import GROUPS, regroup_deprecated
+from sb3_gqn.gqn.settings import GROUPS, DeprecatedAttributes, regroup_deprecated
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
-class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
+class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicyAlgorithm):
     """
     Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose resolution grows from
     coarse to fine during training. Paper: https://arxiv.org/abs/2404.04253 (Seyde et al., L4DC 2024); the other
