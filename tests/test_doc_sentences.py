@@ -170,6 +170,26 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         ),
         "seed must be None or an integer in [0, 2**32 - 1], got -1": lambda: GQN("MlpPolicy", DecliningEnv(), seed=-1),
         "total_timesteps must be an integer >= 0, got -5": lambda: model.learn(-5),
+        "callback[0] must be a BaseCallback or a callable, got None": lambda: model.learn(1, callback=[None]),
+        "log_interval must be an integer >= 1 (episodes between log dumps) or None, got 0": lambda: model.learn(
+            1, log_interval=0
+        ),
+        "policy='MultiInputPolicy' needs a Dict observation, but this env's is Box(-1.0, 1.0, (3,), float32): use "
+        "'MlpPolicy' (or 'CnnPolicy' for images)": lambda: GQN("MultiInputPolicy", DecliningEnv()),
+        "policy='CnnPolicy' needs an image observation": lambda: GQN("CnnPolicy", DecliningEnv()),
+        "env is None: GQN builds its networks from the env's spaces; pass an env or an env id, or load a saved model "
+        "with GQN.load(path)": lambda: GQN("MlpPolicy", None),
+        "env='NoSuchEnv-v0' is no Gymnasium env id this installation knows: Environment `NoSuchEnv` doesn't exist.": (
+            lambda: GQN("MlpPolicy", "NoSuchEnv-v0")
+        ),
+        "device must be 'auto', a torch.device or a device string torch reads ('cpu', 'cuda', 'cuda:1', 'mps', ...), "
+        "got 'gpu'": lambda: GQN("MlpPolicy", DecliningEnv(), device="gpu"),
+        "verbose must be an integer >= 0, got '1'": lambda: GQN("MlpPolicy", DecliningEnv(), verbose="1"),
+        "acting_tau must be a finite number in (0, 1], got 0; None switches it off (act on the online network)": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), acting_tau=0
+        ),
+        "predict()'s observation is a dict, but the model observes Box(-1.0, 1.0, (3,), float32): pass an array of "
+        "shape (3,) (or (n_envs, *(3,)) for a batch)": lambda: model.predict({"state": np.zeros(3)}),
         "callback must be a BaseCallback, a list of them, a callable or None, got 'x'": lambda: model.learn(1, callback="x"),
         "level must be an integer index into bin_levels [2, 3, 5, 9] (or None), got 1.5": lambda: model.grow(1.5),
         "A GQN or DecQN policy acts on bin indices (Discrete or MultiDiscrete), got Box(": lambda: SAC.load(

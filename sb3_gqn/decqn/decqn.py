@@ -72,7 +72,7 @@ class DecQN(GQN):
         self: SelfDecQN,
         total_timesteps: int,
         callback: MaybeCallback = None,
-        log_interval: int = 4,
+        log_interval: int | None = 4,
         tb_log_name: str = "DecQN",
         reset_num_timesteps: bool = True,
         progress_bar: bool = False,

@@ -17,9 +17,12 @@ from stable_baselines3.common.utils import LinearSchedule, polyak_update
 
 from sb3_gqn.common.arguments import (
     check_choice,
+    check_device,
     check_learning_arguments,
+    check_log_interval,
     check_model_arguments,
     check_total_timesteps,
+    check_verbose,
     warn_if_learn_does_not_train,
 )
 from sb3_gqn.common.buffers import (
@@ -196,6 +199,8 @@ class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicy
             max_grad_norm=max_grad_norm, stats_window_size=stats_window_size,
         )  # fmt: skip
         check_model_arguments(policy_kwargs, replay_buffer_kwargs, seed, learning)
+        seed = None if seed is None else int(seed)  # a NumPy integer too: the envs' seeding takes Python ints only
+        verbose, device = check_verbose(verbose), check_device(device)
         check_replay_buffer_kwargs(replay_buffer_class, replay_buffer_kwargs or {})
         growth_init, growth_schedule = growth_settings(growth, growth_kwargs)
         check_choice("exploration", exploration, EXPLORATION_MODES)
@@ -203,6 +208,11 @@ class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicy
         decoding, decoding_kwargs = checked_decoding(decoding, decoding_kwargs)
         if bins is not None:
             bins = checked_bins(bins)  # a bad value fails here, before the env is made
+        if env is None and _init_setup_model:
+            raise ValueError(
+                f"env is None: {type(self).__name__} builds its networks from the env's spaces; pass an env or an env "
+                f"id, or load a saved model with {type(self).__name__}.load(path)"
+            )
         made_env = resolve_env(env)
         if made_env is not None:
             check_action_space(made_env.action_space)
@@ -215,7 +225,7 @@ class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicy
         self.bin_levels = bin_levels_from(bins) if bins is not None else []
         super().__init__(
             policy, made_env if made_env is not None else env, learning["learning_rate"], learning["buffer_size"],
-            learning["learning_starts"], learning["batch_size"], learning["tau"], learning["gamma"], train_freq,
+            learning["learning_starts"], learning["batch_size"], learning["tau"], learning["gamma"], learning["train_freq"],
             learning["gradient_steps"],
             action_noise=None,  # exploration is epsilon-greedy over the active bins
             replay_buffer_class=replay_buffer_class, replay_buffer_kwargs=replay_buffer_kwargs,
@@ -414,7 +424,7 @@ class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicy
         self: SelfGQN,
         total_timesteps: int,
         callback: MaybeCallback = None,
-        log_interval: int = 4,
+        log_interval: int | None = 4,
         tb_log_name: str = "GQN",
         reset_num_timesteps: bool = True,
         progress_bar: bool = False,
@@ -422,11 +432,17 @@ class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicy
         return super().learn(
             total_timesteps=check_total_timesteps(total_timesteps),
             callback=callback,
-            log_interval=log_interval,
+            log_interval=check_log_interval(log_interval),  # type: ignore[arg-type]  # None: SB3's collect never dumps
             tb_log_name=tb_log_name,
             reset_num_timesteps=reset_num_timesteps,
             progress_bar=progress_bar,
         )
+
+    def set_env(self, env: GymEnv | str, force_reset: bool = True) -> None:
+        """SB3's ``set_env``, taking an env id as the constructor does (``model.set_env("Pendulum-v1")``)."""
+        made_env = resolve_env(env)
+        assert made_env is not None, "resolve_env returns None only for None"
+        super().set_env(made_env, force_reset)
 
     def _excluded_save_params(self) -> list[str]:
         excluded = ["q_net", "q_net_target", "_active_bin_indices", "_learning_bins_mask", "action_grid", "update_precision"]

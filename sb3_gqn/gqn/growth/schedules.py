@@ -421,12 +421,13 @@ class AdaptiveGrowth:
 
         A new run (``new_run``: ``learn()`` with ``reset_num_timesteps=True``) fixes :attr:`budget` to its ``budget``
         (its ``total_timesteps``); a continued one (``reset_num_timesteps=False``, a resumed run) keeps the budget fixed
-        before, and takes ``budget`` only when none is. When the env was reset (new run, ``set_env``, load), the
+        before, and takes ``budget`` only when none is. A run of no steps (``learn(0)``) fixes none: the cadence of
+        a run continued after it reads that run's budget. When the env was reset (new run, ``set_env``, load), the
         episodes in progress are gone: their partial returns are dropped and greedy evaluation episodes that were
         running are started again. A run whose step counter was reset evaluates one cadence on.
         """
-        if budget is not None and (new_run or self.budget is None):
-            self.budget = int(budget)
+        if budget is not None and (new_run or not self.budget):
+            self.budget = int(budget) if budget > 0 else None
         cadence = self.steps_between_readings
         if self.next_eval_step == 0 or self.next_eval_step > num_timesteps + cadence:
             self.next_eval_step = num_timesteps + cadence
