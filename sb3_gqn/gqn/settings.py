@@ -156,7 +156,7 @@ def _deprecated_attribute(keyword: str) -> property:
         )
         return read(model)
 
-    return property(deprecated, doc=f"0.2's attribute, deprecated: :attr:`{spelling}` (read-only)")
+    return property(deprecated, doc=f"0.2's attribute, deprecated: ``{spelling}`` (read-only)")
 
 
 #: The 0.2 attributes that :class:`DeprecatedAttributes` reads: every 0.2 keyword but ``growth_init`` and
