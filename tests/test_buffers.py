@@ -206,6 +206,16 @@ def test_huber_td_loss_by_hand():
     np.testing.assert_allclose(td.numpy(), [0.5, 3.0, 2.0])
 
 
+def test_the_log_follows_an_annealed_beta_to_1():
+    model = GQN(
+        "MlpPolicy", DecliningEnv(), learning_starts=50, batch_size=16, seed=0, growth=None, bins=3,
+        replay_buffer_kwargs=dict(beta=0.4, beta_annealing=True), policy_kwargs=dict(net_arch=[8]),
+    )  # fmt: skip
+    model.learn(100)
+    # the last update runs at progress remaining 1 - 100 / 100 = 0, where beta has moved from 0.4 all the way to 1
+    assert model.logger.name_to_value["replay/beta"] == pytest.approx(1.0)
+
+
 def test_gqn_uses_prioritized_replay_by_default():
     model = GQN("MlpPolicy", DecliningEnv(), learning_starts=50, batch_size=16, train_freq=1, seed=0, growth=None, bins=3)
     buffer = model.replay_buffer
@@ -214,7 +224,9 @@ def test_gqn_uses_prioritized_replay_by_default():
     model.learn(300)
     stored = buffer.priorities.leaves[: buffer.size()]
     assert not np.allclose(stored, stored[0])  # the TD errors were written back
-    assert model.logger.name_to_value.get("replay/importance_sampling_exponent", 0.2) == pytest.approx(0.2)
+    # the last update's log (learn's last dump came before it): beta under its 0.3 name, nothing under 0.2's
+    assert model.logger.name_to_value["replay/beta"] == pytest.approx(0.2)
+    assert "replay/importance_sampling_exponent" not in model.logger.name_to_value
 
     uniform = GQN("MlpPolicy", DecliningEnv(), replay_buffer_kwargs=dict(prioritized=False), bins=3, growth=None)
     assert type(uniform.replay_buffer) is NStepReplayBuffer and not uniform.prioritized_replay

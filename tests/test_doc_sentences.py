@@ -154,6 +154,8 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
     rate = ActionRatePenalty(gym.make("Pendulum-v1"))
     rate.reset(seed=0)
     model = GQN("MlpPolicy", DecliningEnv(), bins=(2, 9), growth=None, **tiny)
+    many_choices = DecliningEnv()
+    many_choices.action_space = gym.spaces.Discrete(2000)
     cases = {
         "bins must be an int >= 2 or an (initial, final) pair of ints, got '9'": lambda: GQN(
             "MlpPolicy", DecliningEnv(), bins="9"
@@ -162,9 +164,12 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         "bins=(2, 8) cannot be nested: doubling the intervals from 2 bins gives [2, 3, 5] then 9, never 8": lambda: GQN(
             "MlpPolicy", DecliningEnv(), bins=(2, 8)
         ),
-        "bins must be a single int >= 2 for DecQN, got (2, 9); use GQN for (initial, final) pairs": lambda: DecQN(
-            "MlpPolicy", DecliningEnv(), bins=(2, 9)
-        ),
+        "bins: at most MAX_BINS=1025 bins per action dimension (four doublings above the paper's finest, 65), got "
+        "1000000000": lambda: GQN("MlpPolicy", DecliningEnv(), bins=10**9),
+        "bins must be a single int from 2 to MAX_BINS=1025 for DecQN, got (2, 9); use GQN for (initial, final) "
+        "pairs": lambda: DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9)),
+        "the env's action space Discrete(2000) has 2000 choices per dimension: GQN and DecQN take at most "
+        "MAX_BINS=1025": lambda: GQN("MlpPolicy", many_choices),
         "bins=(3, 9) needs 9 choices per action dimension, but the env's action space Discrete(2) has 2: pass bins=2 "
         "(or a pair ending in it)": lambda: GQN("MlpPolicy", "CartPole-v1", bins=(3, 9)),
         "decoding_kwargs['temperature'] must be None or a number in [1.175e-38, 3.403e+38], float32's positive normal "
@@ -186,6 +191,26 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
         ),
         "seed must be None or an integer in [0, 2**32 - 1], got -1": lambda: GQN("MlpPolicy", DecliningEnv(), seed=-1),
         "total_timesteps must be an integer >= 0, got -5": lambda: model.learn(-5),
+        "callback[0] must be a BaseCallback or a callable, got None": lambda: model.learn(1, callback=[None]),
+        "log_interval must be an integer >= 1 (episodes between log dumps) or None, got 0": lambda: model.learn(
+            1, log_interval=0
+        ),
+        "policy='MultiInputPolicy' needs a Dict observation, but this env's is Box(-1.0, 1.0, (3,), float32): use "
+        "'MlpPolicy' (or 'CnnPolicy' for images)": lambda: GQN("MultiInputPolicy", DecliningEnv()),
+        "policy='CnnPolicy' needs an image observation": lambda: GQN("CnnPolicy", DecliningEnv()),
+        "env is None: GQN builds its networks from the env's spaces; pass an env or an env id, or load a saved model "
+        "with GQN.load(path)": lambda: GQN("MlpPolicy", None),
+        "env='NoSuchEnv-v0' is no Gymnasium env id this installation knows: Environment `NoSuchEnv` doesn't exist.": (
+            lambda: GQN("MlpPolicy", "NoSuchEnv-v0")
+        ),
+        "device must be 'auto', a torch.device or a device string torch reads ('cpu', 'cuda', 'cuda:1', 'mps', ...), "
+        "got 'gpu'": lambda: GQN("MlpPolicy", DecliningEnv(), device="gpu"),
+        "verbose must be an integer >= 0, got '1'": lambda: GQN("MlpPolicy", DecliningEnv(), verbose="1"),
+        "acting_tau must be a finite number in (0, 1], got 0; None switches it off (act on the online network)": lambda: GQN(
+            "MlpPolicy", DecliningEnv(), acting_tau=0
+        ),
+        "predict()'s observation is a dict, but the model observes Box(-1.0, 1.0, (3,), float32): pass an array of "
+        "shape (3,) (or (n_envs, *(3,)) for a batch)": lambda: model.predict({"state": np.zeros(3)}),
         "callback must be a BaseCallback, a list of them, a callable or None, got 'x'": lambda: model.learn(1, callback="x"),
         "level must be an integer index into bin_levels [2, 3, 5, 9] (or None), got 1.5": lambda: model.grow(1.5),
         "A GQN or DecQN policy acts on bin indices (Discrete or MultiDiscrete), got Box(": lambda: SAC.load(
@@ -203,3 +228,12 @@ def test_the_bad_input_table_gives_the_messages_the_code_raises(tmp_path):
     for message, function in cases.items():
         assert message in raised(function), message
         assert message in table, message
+
+
+def test_the_gqn_page_quotes_the_line_auto_precision_says(monkeypatch):
+    from sb3_gqn.common import precision
+
+    monkeypatch.setattr(precision, "cpu_flags", lambda: frozenset({"avx512f", "avx512_bf16"}))
+    line = f"GQN: {precision.resolution_note('auto', 'cpu')}"
+    assert line == 'GQN: precision="auto" resolved to "bf16" (this CPU has AVX-512 BF16 matrix instructions)'
+    assert f"``{line}``" in flat("docs/modules/gqn.rst")

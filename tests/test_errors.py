@@ -1,11 +1,14 @@
 """Bad input raises a clear error naming the problem."""
 
+import re
+
 import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium import spaces
 
 from sb3_gqn import GQN, DecQN
+from sb3_gqn.gqn.growth.schedules import MAX_BINS, nested_bin_levels
 from tests.envs import DecliningEnv, NaNRewardEnv
 
 
@@ -50,6 +53,66 @@ def test_bins_that_cannot_nest(bins):
 def test_bins_out_of_range(bins):
     with pytest.raises(ValueError):
         GQN("MlpPolicy", DecliningEnv(), bins=bins)
+
+
+GQN_LIMIT_MESSAGE = r"bins: at most MAX_BINS=1025 bins per action dimension \(four doublings above the paper's finest, 65\), "
+GQN_LIMIT_MESSAGE += "got "
+DECQN_BINS_MESSAGE = r"bins must be a single int from 2 to MAX_BINS=1025 for DecQN, got "
+
+
+@pytest.mark.parametrize(
+    ("algo", "bins", "message"),
+    [
+        (GQN, 10**9, GQN_LIMIT_MESSAGE + "1000000000"),
+        (GQN, 1027, GQN_LIMIT_MESSAGE + "1027"),
+        (GQN, (3, 2**20 + 1), GQN_LIMIT_MESSAGE + "1048577"),
+        (GQN, (2, 2049), GQN_LIMIT_MESSAGE + "2049"),
+        (DecQN, 10**9, DECQN_BINS_MESSAGE + "1000000000"),
+        (DecQN, 1026, DECQN_BINS_MESSAGE + "1026"),
+    ],
+    ids=["GQN-1e9", "GQN-1027", "GQN-pair-2**20+1", "GQN-pair-2049", "DecQN-1e9", "DecQN-1026"],
+)
+def test_bins_above_the_limit_are_refused_before_anything_is_built(algo, bins, message):
+    with pytest.raises(ValueError, match=message):  # the check runs before the env is made or any network built
+        algo("MlpPolicy", "Pendulum-v1", bins=bins, _init_setup_model=False)
+
+
+def test_the_limit_is_a_nested_level_and_bins_up_to_it_build():
+    assert nested_bin_levels(9, 1025) == [9, 17, 33, 65, 129, 257, 513, 1025] and MAX_BINS == 1025
+    model = GQN("MlpPolicy", DecliningEnv(action_dims=1), bins=(513, 1025), policy_kwargs=dict(net_arch=[8]))
+    # 1025 bins per dimension: the head holds 1025 outputs of an 8-wide torso
+    assert model.q_net.head.weight.shape == (1025, 8) and model.active_bins == 513
+    assert DecQN("MlpPolicy", DecliningEnv(action_dims=1), bins=1025, policy_kwargs=dict(net_arch=[8])).bin_levels == [1025]
+
+
+@pytest.mark.parametrize(
+    ("action_space", "choices", "gqn_bins"),
+    [
+        (spaces.Discrete(1025), 1025, (3, 1025)),
+        (spaces.Discrete(1000), 1000, 1000),
+        (spaces.MultiDiscrete([1024] * 2), 1024, 1024),
+    ],
+    ids=["Discrete(1025)", "Discrete(1000)", "MultiDiscrete(1024x2)"],
+)
+def test_discrete_envs_with_many_choices_work_up_to_the_limit(action_space, choices, gqn_bins):
+    env = env_with_action_space(action_space)
+    tiny = dict(policy_kwargs=dict(net_arch=[8]), learning_starts=0, batch_size=4, buffer_size=100)
+    gqn = GQN("MlpPolicy", env, **tiny)
+    assert gqn.bins == gqn_bins and gqn.policy.max_bins == choices
+    gqn.learn(10)
+    assert DecQN("MlpPolicy", env, **tiny).bins == choices
+
+
+@pytest.mark.parametrize(
+    ("action_space", "choices"),
+    [(spaces.Discrete(1026), 1026), (spaces.MultiDiscrete([2000, 2000]), 2000)],
+    ids=["Discrete(1026)", "MultiDiscrete(2000x2)"],
+)
+@pytest.mark.parametrize("algo", [GQN, DecQN])
+def test_a_discrete_env_with_more_choices_than_the_limit_is_refused_by_name(action_space, choices, algo):
+    message = rf"the env's action space {re.escape(str(action_space))} has {choices} choices per dimension: .* MAX_BINS=1025"
+    with pytest.raises(ValueError, match=message):
+        algo("MlpPolicy", env_with_action_space(action_space), _init_setup_model=False)
 
 
 @pytest.mark.parametrize(
@@ -119,7 +182,7 @@ def test_load_with_other_bins_discretizes_to_saved_bins(tmp_path):
 def test_decqn_rejects_growth_and_pairs():
     with pytest.raises(ValueError, match="static"):
         DecQN("MlpPolicy", DecliningEnv(), growth="linear")
-    with pytest.raises(ValueError, match=r"bins must be a single int >= 2 for DecQN, got \(2, 9\); use GQN for"):
+    with pytest.raises(ValueError, match=DECQN_BINS_MESSAGE + r"\(2, 9\); use GQN for"):
         DecQN("MlpPolicy", DecliningEnv(), bins=(2, 9))
 
 

@@ -7,6 +7,7 @@ most half a unit in the last place: a relative error of at most ``u = 2 ** -8``.
 
 from __future__ import annotations
 
+import csv
 import warnings
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch as th
+from stable_baselines3.common.logger import configure
 from torch import nn
 
 from sb3_gqn import GQN, DecQN
@@ -25,6 +27,7 @@ from sb3_gqn.common.precision import (
     resolve_precision,
     round_to_bf16,
 )
+from tests.envs import DecliningEnv
 
 #: bfloat16's unit roundoff: half a unit in the last of its 8 significant bits
 UNIT_ROUNDOFF = 2.0**-8
@@ -211,3 +214,51 @@ def test_the_export_of_a_bf16_model_is_float32_and_acts_as_predict(tmp_path, cpu
     actions = scripted(th.as_tensor(observations))
     assert actions.dtype == th.float32
     np.testing.assert_allclose(actions.numpy(), model.predict(observations, deterministic=True)[0], rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("flags", "line"),
+    [
+        (
+            {"avx2", "avx512f", "avx512_bf16"},
+            'GQN: precision="auto" resolved to "bf16" (this CPU has AVX-512 BF16 matrix instructions)',
+        ),
+        ({"avx2", "amx_bf16", "amx_tile"}, 'GQN: precision="auto" resolved to "bf16" (this CPU has AMX bfloat16 tiles)'),
+        (
+            {"avx2", "fma"},
+            'GQN: precision="auto" resolved to "fp32" (this CPU has no bfloat16 matrix instructions (AMX or AVX-512 BF16))',
+        ),
+    ],
+    ids=["avx512_bf16", "amx", "neither"],
+)
+def test_auto_says_once_what_it_resolved_to_and_why_with_verbose(monkeypatch, capsys, flags, line):
+    monkeypatch.setattr(precision_module, "cpu_flags", lambda: frozenset(flags))
+    GQN("MlpPolicy", "Pendulum-v1", precision="auto", verbose=1, device="cpu", policy_kwargs=SMALL_TORSO)
+    said = [text for text in capsys.readouterr().out.splitlines() if "precision" in text]
+    assert said == [line]
+    GQN("MlpPolicy", "Pendulum-v1", precision="auto", verbose=0, device="cpu", policy_kwargs=SMALL_TORSO)
+    GQN("MlpPolicy", "Pendulum-v1", precision="fp32", verbose=1, device="cpu", policy_kwargs=SMALL_TORSO)
+    assert "precision" not in capsys.readouterr().out  # silent without verbose, and nothing to say for a chosen precision
+
+
+def test_decqn_names_itself_and_a_loaded_model_says_it_again(tmp_path, capsys, cpu_with_amx):
+    DecQN("MlpPolicy", "Pendulum-v1", bins=5, precision="auto", device="cpu", policy_kwargs=SMALL_TORSO).save(tmp_path / "m")
+    assert capsys.readouterr().out == ""
+    DecQN.load(tmp_path / "m", verbose=1)
+    assert 'DecQN: precision="auto" resolved to "bf16" (this CPU has AMX bfloat16 tiles)' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("precision", "flags", "logged"),
+    [("auto", {"avx512_bf16"}, "bf16"), ("auto", {"avx2"}, "fp32"), ("fp32", {"avx512_bf16"}, "fp32")],
+)
+def test_learn_records_the_update_precision_in_the_log(tmp_path, monkeypatch, precision, flags, logged):
+    monkeypatch.setattr(precision_module, "cpu_flags", lambda: frozenset(flags))
+    tiny = dict(learning_starts=10, batch_size=8, buffer_size=100, policy_kwargs=dict(net_arch=[8]))
+    model = GQN("MlpPolicy", DecliningEnv(), precision=precision, device="cpu", **tiny)
+    model.set_logger(configure(str(tmp_path), ["csv"]))
+    model.learn(40)  # 5-step episodes: a row every 4 episodes, at steps 20 and 40
+    with open(tmp_path / "progress.csv") as file:
+        rows = list(csv.DictReader(file))
+    assert [row["time/total_timesteps"] for row in rows] == ["20", "40"]
+    assert rows[0]["train/precision"] == logged  # recorded once, at the start of learn()

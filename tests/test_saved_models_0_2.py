@@ -126,6 +126,29 @@ def test_a_prioritized_checkpoint_keeps_its_priority_settings_and_priorities(alg
         assert_equal_but_for_rounding(model.replay_buffer.priorities.leaves, EXPECTED["prioritized_continued_priorities"])
 
 
+def test_the_0_2_attributes_of_0_2_files_read_as_saved_with_a_warning():
+    adaptive = GQN.load(FIXTURES / "gqn_adaptive_checkpoint.zip", env=short_pendulum())
+    prioritized = DecQN.load(FIXTURES / "decqn5_prioritized_checkpoint.zip", env=short_pendulum())
+    expectation = GQN.load(FIXTURES / "gqn_expectation.zip", env=short_pendulum())
+    with pytest.warns(DeprecationWarning, match="is the 0.2 spelling"):
+        # make_fixtures.py's keywords: growth_eval_freq=150, growth_eval_episodes=2, growth_window=2,
+        # growth_returns="evaluation", growth_patience=3, growth_min_improvement=0.1, growth_probation=2
+        growth = [
+            adaptive.growth_eval_freq, adaptive.growth_eval_episodes, adaptive.growth_window, adaptive.growth_returns,
+            adaptive.growth_patience, adaptive.growth_min_improvement, adaptive.growth_probation,
+        ]  # fmt: skip
+        # priority_exponent=0.4, importance_sampling_exponent=0.5, importance_sampling_annealing=True
+        priorities = [
+            prioritized.priority_exponent, prioritized.importance_sampling_exponent,
+            prioritized.importance_sampling_annealing,
+        ]  # fmt: skip
+        temperature = expectation.decoding_temperature  # decoding_temperature=0.5
+    assert growth == [150, 2, 2, "evaluation", 3, 0.1, 2]
+    assert priorities == [0.4, 0.5, True] and temperature == 0.5
+    # the file's own attributes of these names were moved into their groups when it loaded
+    assert not {"priority_exponent", "importance_sampling_exponent", "decoding_temperature"} & set(vars(prioritized))
+
+
 def test_an_expectation_decoding_model_acts_at_its_temperature():
     model = GQN.load(FIXTURES / "gqn_expectation.zip", env=short_pendulum())
     assert (model.decoding, model.softmax_temperature, model.exploration) == ("expectation", 0.5, "per_dimension")

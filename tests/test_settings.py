@@ -5,7 +5,10 @@ in ``load``, in rl-zoo3's ``-params`` and YAML files and in the Optuna converter
 from __future__ import annotations
 
 import inspect
+import json
+import re
 import warnings
+import zipfile
 from pathlib import Path
 
 import gymnasium as gym
@@ -173,9 +176,111 @@ def test_load_takes_the_groups_and_the_0_2_keywords(tmp_path):
     with pytest.warns(DeprecationWarning, match="importance_sampling_annealing"):
         loaded = GQN.load(tmp_path / "model", importance_sampling_annealing=True)
     assert loaded.replay_buffer_kwargs["alpha"] == 0.5 and loaded.replay_buffer.beta_annealing
-    assert not hasattr(loaded, "growth_kwargs") and not hasattr(loaded, "_settings_given_at_load")
+    # the settings given to load live in their groups, not as attributes of their own
+    assert "growth_kwargs" not in vars(loaded) and not hasattr(loaded, "_settings_given_at_load")
     with pytest.raises(ValueError, match=r"growth_kwargs has no setting 'patiense'"):
         GQN.load(tmp_path / "model", growth_kwargs=dict(patiense=4))
+
+
+#: how 0.3 reads each 0.2 attribute, as its warning names it
+NEW_READINGS = {
+    "growth_eval_freq": "model.growth_kwargs['eval_freq']",
+    "growth_eval_episodes": "model.growth_kwargs['eval_episodes']",
+    "growth_window": "model.growth_kwargs['window']",
+    "growth_returns": "model.growth_kwargs['returns_source']",
+    "growth_patience": "model.growth_kwargs['patience']",
+    "growth_min_improvement": "model.growth_kwargs['min_improvement']",
+    "growth_probation": "model.growth_kwargs['probation']",
+    "priority_exponent": "model.replay_buffer.alpha",
+    "importance_sampling_exponent": "model.replay_buffer.initial_beta",
+    "importance_sampling_annealing": "model.replay_buffer.beta_annealing",
+    "decoding_temperature": "model.softmax_temperature",
+}
+
+
+@pytest.mark.parametrize("keyword", sorted(OLD_VALUES))
+def test_each_0_2_attribute_reads_the_value_the_model_runs_with(keyword):
+    group, key = DEPRECATED_KEYWORDS[keyword]
+    decoding = "expectation" if group == "decoding_kwargs" else "argmax"
+    for algo in (GQN, DecQN):
+        if algo is DecQN and group == "growth_kwargs":
+            continue  # DecQN has no growth settings
+        model = algo("MlpPolicy", "Pendulum-v1", decoding=decoding, **{group: {key: OLD_VALUES[keyword]}}, **TINY)
+        if keyword in NEW_READINGS:  # a 0.2 attribute: it warns, naming how 0.3 reads it, at the caller's line
+            message = rf"{algo.__name__}\.{keyword} is the 0\.2 spelling, .* read {re.escape(NEW_READINGS[keyword])}$"
+            with pytest.warns(DeprecationWarning, match=message) as record:
+                value = getattr(model, keyword)
+            assert record[0].filename == __file__
+        else:  # growth_init and prioritized_replay are 0.3's attributes too
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", DeprecationWarning)
+                value = getattr(model, keyword)
+        assert value == OLD_VALUES[keyword]
+
+
+def test_the_0_2_attributes_follow_the_live_settings_and_keep_their_defaults(tmp_path):
+    model = GQN("MlpPolicy", DecliningEnv(), **TINY)
+    with pytest.warns(DeprecationWarning):
+        defaults = [getattr(model, keyword) for keyword in NEW_READINGS]
+    # the schedule's and the prioritized buffer's defaults, and the argmax's reading of the expectation's 0.3
+    assert defaults == [None, 1, 3, "evaluation", 2, 0.05, None, 0.6, 0.2, False, 0.3]
+    model.save(tmp_path / "model")
+    loaded = GQN.load(tmp_path / "model", growth_kwargs=dict(patience=5), decoding="relative")
+    with pytest.warns(DeprecationWarning):
+        assert (loaded.growth_patience, loaded.decoding_temperature) == (5, 0.1)
+
+
+def test_a_0_2_attribute_the_model_does_not_have_says_why():
+    linear = GQN("MlpPolicy", DecliningEnv(), growth="linear", replay_buffer_kwargs=dict(prioritized=False), **TINY)
+    with pytest.warns(DeprecationWarning), pytest.raises(AttributeError, match=r"GQN with growth='linear' has no adaptive"):
+        _ = linear.growth_patience
+    with pytest.warns(DeprecationWarning), pytest.raises(AttributeError, match=r"GQN samples its replay uniformly: it has no"):
+        _ = linear.priority_exponent
+    with pytest.warns(DeprecationWarning):
+        assert not hasattr(linear, "growth_window") and not hasattr(linear, "importance_sampling_exponent")
+
+
+def test_growth_kwargs_reads_the_settings_in_the_constructors_spelling():
+    defaults = GQN("MlpPolicy", DecliningEnv(), **TINY).growth_kwargs
+    assert defaults == {
+        "init": "interpolate",
+        "eval_freq": None,
+        "eval_fraction": 0.05,
+        "eval_episodes": 1,
+        "window": 3,
+        "returns_source": "evaluation",
+        "patience": 2,
+        "min_improvement": 0.05,
+        "probation": None,
+    }
+    given = dict(init="none", eval_freq=40, eval_episodes=2, window=4, patience=None, min_improvement=0.1, probation=3)
+    model = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=given, **TINY)
+    assert model.growth_kwargs == {**given, "eval_fraction": None, "returns_source": "evaluation"}
+    # it builds a model that grows the same way; each read is a new dict
+    again = GQN("MlpPolicy", DecliningEnv(), growth_kwargs=model.growth_kwargs, **TINY)
+    assert again.growth_kwargs == model.growth_kwargs and again.growth_kwargs is not again.growth_kwargs
+    linear = GQN("MlpPolicy", DecliningEnv(), growth="linear", growth_kwargs=dict(init="none"), **TINY)
+    assert linear.growth_kwargs == {"init": "none"}
+    assert DecQN("MlpPolicy", DecliningEnv(), **TINY).growth_kwargs == {"init": "interpolate"}
+    with pytest.raises(AttributeError):
+        model.growth_kwargs = dict(patience=3)  # read-only: load(path, growth_kwargs=...) changes them
+
+
+def test_growth_kwargs_given_to_load_or_held_by_a_file_still_load(tmp_path):
+    GQN("MlpPolicy", DecliningEnv(), **TINY).save(tmp_path / "model.zip")
+    loaded = GQN.load(tmp_path / "model.zip", growth_kwargs=dict(window=5, init="none"))
+    assert loaded.growth_kwargs == {**AdaptiveGrowth().settings(), "init": "none", "window": 5}
+    # a file whose data holds a growth_kwargs attribute: SB3's load writes it into the instance, where it is applied
+    with zipfile.ZipFile(tmp_path / "model.zip") as archive:
+        entries = {name: archive.read(name) for name in archive.namelist()}
+    data = json.loads(entries["data"])
+    data["growth_kwargs"] = {"patience": 4}
+    entries["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(tmp_path / "edited.zip", "w") as archive:
+        for name, content in entries.items():
+            archive.writestr(name, content)
+    edited = GQN.load(tmp_path / "edited.zip")
+    assert edited.growth_kwargs["patience"] == 4 and "growth_kwargs" not in vars(edited)
 
 
 def test_the_shipped_files_use_the_new_spelling():

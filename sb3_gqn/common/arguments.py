@@ -9,6 +9,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
+import torch as th
 
 
 def _is_int(value: Any) -> bool:
@@ -63,14 +64,47 @@ def check_choice(name: str, value: Any, choices: Iterable[Any]) -> None:
         raise ValueError(f"{name} must be one of {choices}, got {value!r}")
 
 
-def check_train_freq(value: Any) -> None:
-    """``train_freq``: an int >= 1, or ``(int >= 1, "step" | "episode")`` as SB3 accepts it."""
+def check_train_freq(value: Any) -> int | tuple[int, str]:
+    """``train_freq``: an int >= 1, or ``(int >= 1, "step" | "episode")``; returned as SB3 takes it (a YAML file's list
+    ``[4, "step"]`` as a tuple, NumPy integers as ints)."""
     if isinstance(value, (tuple, list)):
-        valid = len(value) == 2 and _is_int(value[0]) and value[0] >= 1 and value[1] in ("step", "episode")
-    else:
-        valid = _is_int(value) and value >= 1
-    if not valid:
-        raise ValueError(f'train_freq must be an integer >= 1 or a pair (integer >= 1, "step" or "episode"), got {value!r}')
+        if len(value) == 2 and _is_int(value[0]) and value[0] >= 1 and value[1] in ("step", "episode"):
+            return int(value[0]), str(value[1])
+    elif _is_int(value) and value >= 1:
+        return int(value)
+    raise ValueError(f'train_freq must be an integer >= 1 or a pair (integer >= 1, "step" or "episode"), got {value!r}')
+
+
+def check_verbose(value: Any) -> int:
+    """``verbose``: an int >= 0 (``True`` and ``False`` as 1 and 0, as SB3 reads them)."""
+    return check_int("verbose", int(value) if isinstance(value, (bool, np.bool_)) else value, 0)
+
+
+def check_device(value: Any) -> th.device | str:
+    """``device``: ``"auto"``, a ``torch.device`` or a device string torch reads (``"cpu"``, ``"cuda"``, ``"cuda:1"``,
+    ``"mps"``); ``ValueError`` naming it otherwise (torch's own error is a ``RuntimeError`` deep in SB3)."""
+    if isinstance(value, th.device) or value == "auto":
+        return value
+    if isinstance(value, str):
+        try:
+            th.device(value)
+            return value
+        except RuntimeError:
+            pass
+    raise ValueError(
+        f"device must be 'auto', a torch.device or a device string torch reads ('cpu', 'cuda', 'cuda:1', 'mps', ...), "
+        f"got {value!r}"
+    )
+
+
+def check_log_interval(value: Any) -> int | None:
+    """``learn``'s ``log_interval``: ``None`` (no periodic dump) or an int >= 1, the episodes between two dumps of the
+    log (0 would divide by zero at the first episode's end, after transitions were stored)."""
+    if value is None:
+        return None
+    if _is_int(value) and value >= 1:
+        return int(value)
+    raise ValueError(f"log_interval must be an integer >= 1 (episodes between log dumps) or None, got {value!r}")
 
 
 def check_replay_sizes(buffer_size: int, batch_size: int, n_steps: int) -> None:
@@ -101,25 +135,31 @@ _NUMBER_ARGUMENTS = {
     "exploration_initial_eps": (0.0, 1.0, False),
     "exploration_final_eps": (0.0, 1.0, False),
 }
-#: optional numeric arguments (``None`` switches them off): (low, high, low_open)
-_OPTIONAL_NUMBER_ARGUMENTS = {"acting_tau": (0.0, 1.0, True), "max_grad_norm": (0.0, math.inf, True)}
+#: optional numeric arguments: (low, high, low_open, what ``None`` does: it switches them off)
+_OPTIONAL_NUMBER_ARGUMENTS = {
+    "acting_tau": (0.0, 1.0, True, "act on the online network"),
+    "max_grad_norm": (0.0, math.inf, True, "no clipping"),
+}
 
 
 def check_learning_arguments(**arguments: Any) -> dict[str, Any]:
     """GQN's learning arguments (learning rate, replay, update and exploration settings), each checked as
-    above; returns them normalized (ints as ``int``, numbers as ``float``). ``gradient_steps`` may be 0 (SB3's
-    "collect only") or -1 (as many as env steps)."""
+    above; returns them normalized (ints as ``int``, numbers as ``float``, ``train_freq`` as SB3 takes it).
+    ``gradient_steps`` may be 0 (SB3's "collect only") or -1 (as many as env steps)."""
     checked = dict(arguments)
     checked["learning_rate"] = check_learning_rate(arguments["learning_rate"])
     for name, minimum in _INTEGER_ARGUMENTS.items():
         checked[name] = check_int(name, arguments[name], minimum)
     for name, (low, high, low_open) in _NUMBER_ARGUMENTS.items():
         checked[name] = check_number(name, arguments[name], low, high, low_open=low_open)
-    for name, (low, high, low_open) in _OPTIONAL_NUMBER_ARGUMENTS.items():
+    for name, (low, high, low_open, off) in _OPTIONAL_NUMBER_ARGUMENTS.items():
         if arguments[name] is not None:
-            checked[name] = check_number(name, arguments[name], low, high, low_open=low_open)
+            try:
+                checked[name] = check_number(name, arguments[name], low, high, low_open=low_open)
+            except ValueError as error:  # 0 is no way to switch it off: None is
+                raise ValueError(f"{error}; None switches it off ({off})") from None
     checked["gradient_steps"] = check_int("gradient_steps", arguments["gradient_steps"], 0, special=(-1,))
-    check_train_freq(arguments["train_freq"])
+    checked["train_freq"] = check_train_freq(arguments["train_freq"])
     check_replay_sizes(checked["buffer_size"], checked["batch_size"], checked["n_steps"])
     return checked
 

@@ -13,6 +13,7 @@ from typing import Any
 import gymnasium as gym
 from gymnasium import spaces
 from gymnasium.wrappers import FlattenObservation
+from stable_baselines3.common.preprocessing import is_image_space
 from stable_baselines3.common.vec_env import VecEnv
 
 from sb3_gqn.common.wrappers import ActionPenalty, check_finite_box
@@ -91,19 +92,39 @@ def make_env(
 
 
 def resolve_env(env: gym.Env | VecEnv | str | None) -> gym.Env | VecEnv | None:
-    """Make an env given by id (registering its suite first); return other envs unchanged."""
+    """Make an env given by id (registering its suite first); return other envs unchanged.
+
+    :raises ValueError: naming ``env`` for an id Gymnasium does not know or has deprecated (Gymnasium's own message
+        says which)
+    """
     if isinstance(env, str):
         ensure_registered(env)
-        return gym.make(env)
+        try:
+            return gym.make(env)
+        except (gym.error.UnregisteredEnv, gym.error.DeprecatedEnv) as error:
+            raise ValueError(f"env={env!r} is no Gymnasium env id this installation knows: {error}") from error
     return env
 
 
 def check_policy_fits(policy: Any, observation_space: spaces.Space) -> None:
-    """Refuse ``policy="MlpPolicy"`` for a ``Dict`` observation (SB3's flatten extractor would fail later, unclearly)."""
+    """Refuse a policy named for another kind of observation, which SB3's feature extractor would refuse later with
+    an ``AssertionError`` or ``AttributeError``: ``"MlpPolicy"`` for a ``Dict`` observation, ``"CnnPolicy"`` for one
+    that is not an image (a 3-D ``Box``), ``"MultiInputPolicy"`` for one that is not a ``Dict``."""
     if policy == "MlpPolicy" and isinstance(observation_space, spaces.Dict):
         raise ValueError(
             f"policy='MlpPolicy' needs a flat observation, but this env's is a Dict ({list(observation_space)}): use "
             "'MultiInputPolicy', or flatten it (sb3_gqn.common.envs.make_env(env_id) flattens)"
+        )
+    if policy == "CnnPolicy" and not is_image_space(observation_space, check_channels=False, normalized_image=True):
+        raise ValueError(
+            f"policy='CnnPolicy' needs an image observation (a Box of shape (height, width, channels) or (channels, "
+            f"height, width)), but this env's is {observation_space}: use "
+            f"{'MultiInputPolicy' if isinstance(observation_space, spaces.Dict) else 'MlpPolicy'!r}"
+        )
+    if policy == "MultiInputPolicy" and not isinstance(observation_space, spaces.Dict):
+        raise ValueError(
+            f"policy='MultiInputPolicy' needs a Dict observation, but this env's is {observation_space}: use 'MlpPolicy' "
+            "(or 'CnnPolicy' for images)"
         )
 
 

@@ -8,8 +8,11 @@ FLOPs. Where the device has bfloat16 matrix units (:func:`has_bf16_matrix_units`
 kernels; elsewhere they run on float32 kernels with their operands and results rounded to bfloat16 at the same
 points, so a model learns the same on either machine (and no faster on the second).
 
-``precision="auto"`` picks bfloat16 where the device has the units and float32 elsewhere. Acting (``predict``,
-exploration, evaluation) and the exports stay float32: at batch 1 an action costs launch overheads, not FLOPs.
+``precision="auto"`` picks bfloat16 where the device has the units and float32 elsewhere: a CPU with AVX-512 BF16
+(without AMX too) trains in bfloat16. A model with ``verbose >= 1`` says what ``"auto"`` resolved to, and why, when it
+is set up (:func:`resolution_note`); every ``learn()`` records the resolved precision in SB3's log as
+``train/precision``. Acting (``predict``, exploration, evaluation) and the exports stay float32: at batch 1 an action
+costs launch overheads, not FLOPs.
 """
 
 from __future__ import annotations
@@ -62,6 +65,36 @@ def resolve_precision(precision: str, device: th.device | str) -> str:
     if precision == "auto":
         return "bf16" if has_bf16_matrix_units(device) else "fp32"
     return precision
+
+
+def bf16_units_reason(device: th.device | str) -> str:
+    """Why :func:`has_bf16_matrix_units` says what it says for ``device``, in words: ``"this CPU has AVX-512 BF16 matrix
+    instructions"``, ``"this GPU (compute capability 8.0) has bfloat16 matrix units"``, ``"this CPU has no bfloat16
+    matrix instructions (AMX or AVX-512 BF16)"``, ..."""
+    device = th.device(device)
+    if device.type == "cuda":
+        if not th.cuda.is_available():
+            return "CUDA is not available"
+        major, minor = th.cuda.get_device_capability(device)
+        units = "has" if (major, minor) >= (8, 0) else "has no"
+        return f"this GPU (compute capability {major}.{minor}) {units} bfloat16 matrix units"
+    if device.type == "cpu":
+        flags = cpu_flags()
+        if "amx_bf16" in flags:
+            return "this CPU has AMX bfloat16 tiles"
+        if "avx512_bf16" in flags:
+            return "this CPU has AVX-512 BF16 matrix instructions"
+        return "this CPU has no bfloat16 matrix instructions (AMX or AVX-512 BF16)"
+    return f"no bfloat16 matrix units are known on {device.type} devices"
+
+
+def resolution_note(precision: str, device: th.device | str) -> str | None:
+    """One line saying what ``precision="auto"`` resolved to on ``device`` and why (:func:`bf16_units_reason`):
+    ``precision="auto" resolved to "bf16" (this CPU has AVX-512 BF16 matrix instructions)``; ``None`` for a precision
+    that is not ``"auto"`` (nothing was chosen)."""
+    if precision != "auto":
+        return None
+    return f'precision="auto" resolved to "{resolve_precision(precision, device)}" ({bf16_units_reason(device)})'
 
 
 def checked_precision(precision: str, device: th.device | str) -> str:

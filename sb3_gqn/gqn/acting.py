@@ -69,6 +69,20 @@ def checked_decoding(decoding: str, decoding_kwargs: dict[str, Any] | None) -> t
         ) from None
 
 
+def check_observation_kind(observation: Any, observation_space: spaces.Space) -> None:
+    """``predict``'s observation must be a dict exactly when the model observes a ``Dict`` (SB3 answers a mismatch with
+    an ``AssertionError`` or an ``AttributeError``); ``ValueError`` saying what to pass otherwise."""
+    if isinstance(observation, dict) == isinstance(observation_space, spaces.Dict):
+        return
+    if isinstance(observation_space, spaces.Dict):
+        need = f"a dict of arrays with the keys {list(observation_space.spaces)}"
+    else:
+        need = f"an array of shape {observation_space.shape} (or (n_envs, *{observation_space.shape}) for a batch)"
+    raise ValueError(
+        f"predict()'s observation is a {type(observation).__name__}, but the model observes {observation_space}: pass {need}"
+    )
+
+
 def bin_grid(action_space: spaces.Space, max_bins: int) -> tuple[BinGrid | None, spaces.Space]:
     """The grid of ``max_bins`` bins per dimension of a ``Box`` action space and the discrete space of its bin indices,
     which the policy and the replay buffer work on; ``(None, action_space)`` for a discrete space (its own choices)."""
@@ -177,7 +191,10 @@ class Acting:
         :param episode_start: The last masks (can be None, used in recurrent policies)
         :param deterministic: Whether or not to return deterministic actions.
         :return: the model's action and the next hidden state (used in recurrent policies)
+        :raises ValueError: for an observation of the wrong kind (a dict for a model that does not observe a ``Dict``,
+            or the other way round) or shape, or with NaN or +-inf in it
         """
+        check_observation_kind(observation, self.observation_space)
         check_finite_observation(as_batch(observation, self.observation_space), "predict()'s input")
         if deterministic and self.decoding != "argmax" and self.action_grid is not None:
             return self._expected_action(observation), state

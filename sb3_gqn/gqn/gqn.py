@@ -17,9 +17,12 @@ from stable_baselines3.common.utils import LinearSchedule, polyak_update
 
 from sb3_gqn.common.arguments import (
     check_choice,
+    check_device,
     check_learning_arguments,
+    check_log_interval,
     check_model_arguments,
     check_total_timesteps,
+    check_verbose,
     warn_if_learn_does_not_train,
 )
 from sb3_gqn.common.buffers import (
@@ -31,22 +34,28 @@ from sb3_gqn.common.buffers import (
 from sb3_gqn.common.envs import check_action_space, check_policy_fits, resolve_env
 from sb3_gqn.common.finite import check_finite_observation
 from sb3_gqn.common.masking import EXPLORATION_MODES
-from sb3_gqn.common.precision import PRECISIONS, checked_precision, matmul_precision
+from sb3_gqn.common.precision import PRECISIONS, checked_precision, matmul_precision, resolution_note
 from sb3_gqn.common.targets import clip_grad_norm, critic_ensemble_loss, critic_ensemble_targets, decoupled_q_value
 from sb3_gqn.common.torsos import SAVED_BEFORE_DEFAULT_TORSO, with_default_torso
 from sb3_gqn.gqn.acting import Acting, bin_grid, checked_decoding
 from sb3_gqn.gqn.growth.callback import with_growth_callback
 from sb3_gqn.gqn.growth.resolution import GrowingResolution
-from sb3_gqn.gqn.growth.schedules import bin_levels_from, checked_bins, default_bins, growth_settings
+from sb3_gqn.gqn.growth.schedules import (
+    bin_levels_from,
+    check_action_choices,
+    checked_bins,
+    default_bins,
+    growth_settings,
+)
 from sb3_gqn.gqn.policies import CnnPolicy, GQNPolicy, MlpPolicy, MultiInputPolicy
 from sb3_gqn.gqn.q_network import DecoupledQNetwork
 from sb3_gqn.gqn.saving import SavedFiles, upgrade_saved_settings
-from sb3_gqn.gqn.settings import GROUPS, regroup_deprecated
+from sb3_gqn.gqn.settings import GROUPS, DeprecatedAttributes, regroup_deprecated
 
 SelfGQN = TypeVar("SelfGQN", bound="GQN")
 
 
-class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
+class GQN(SavedFiles, DeprecatedAttributes, GrowingResolution, Acting, OffPolicyAlgorithm):
     """
     Growing Q-Networks (GQN): decoupled double Q-learning over a discretized action space whose resolution grows from
     coarse to fine during training. Paper: https://arxiv.org/abs/2404.04253 (Seyde et al., L4DC 2024); the other
@@ -94,7 +103,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
     :param max_grad_norm: The maximum value for the gradient clipping (if None, no clipping)
     :param bins: bins per action dimension: an ``(initial, final)`` pair grows through the nested levels (``(3, 9)``:
         3, 5, 9; the paper's ``(2, 9)``: 2, 3, 5, 9); an int is a static resolution. ``None``: ``(3, 9)`` for a
-        ``Box``, the env's own choices for a discrete space (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`)
+        ``Box``, the env's own choices for a discrete space (:func:`~sb3_gqn.gqn.growth.schedules.default_bins`). At
+        most :data:`~sb3_gqn.gqn.growth.schedules.MAX_BINS` (1025, four doublings above the paper's finest 65) per
+        dimension, for ``bins`` and a discrete space's choices alike
     :param growth: ``"adaptive"`` (eq. 4 plus the plateau rule), ``"linear"`` (with ``N`` levels, level ``g`` opens
         after ``g / (N + 1)`` of ``total_timesteps``) or ``None`` (stay at the first level)
     :param growth_kwargs: the growth settings: ``init`` (``"interpolate"``: an opened bin's head row starts as the mean
@@ -110,7 +121,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         (:data:`~sb3_gqn.common.masking.DEFAULT_DECODING_TEMPERATURES`)
     :param precision: the arithmetic of the training updates' matrix products: ``"fp32"``; ``"bf16"``, bfloat16
         operands with float32 accumulation, weights and optimizer state; ``"auto"``: ``"bf16"`` where the device has
-        bfloat16 matrix units (:mod:`sb3_gqn.common.precision`). Acting, saved weights and the exports are float32
+        bfloat16 matrix units (AMX or AVX-512 BF16 CPUs, Ampere and later GPUs; with ``verbose >= 1`` the model says
+        what it resolved to; :mod:`sb3_gqn.common.precision`); the log records the result as ``train/precision``.
+        Acting, saved weights and the exports are float32
     :param stats_window_size: Window size for the rollout logging, specifying the number of episodes to average
         the reported success rate, mean episode length, and mean reward over
     :param tensorboard_log: the log location for tensorboard (if None, no logging)
@@ -186,6 +199,8 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
             max_grad_norm=max_grad_norm, stats_window_size=stats_window_size,
         )  # fmt: skip
         check_model_arguments(policy_kwargs, replay_buffer_kwargs, seed, learning)
+        seed = None if seed is None else int(seed)  # a NumPy integer too: the envs' seeding takes Python ints only
+        verbose, device = check_verbose(verbose), check_device(device)
         check_replay_buffer_kwargs(replay_buffer_class, replay_buffer_kwargs or {})
         growth_init, growth_schedule = growth_settings(growth, growth_kwargs)
         check_choice("exploration", exploration, EXPLORATION_MODES)
@@ -193,9 +208,15 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         decoding, decoding_kwargs = checked_decoding(decoding, decoding_kwargs)
         if bins is not None:
             bins = checked_bins(bins)  # a bad value fails here, before the env is made
+        if env is None and _init_setup_model:
+            raise ValueError(
+                f"env is None: {type(self).__name__} builds its networks from the env's spaces; pass an env or an env "
+                f"id, or load a saved model with {type(self).__name__}.load(path)"
+            )
         made_env = resolve_env(env)
         if made_env is not None:
             check_action_space(made_env.action_space)
+            check_action_choices(made_env.action_space)
             check_policy_fits(policy, made_env.observation_space)
             if bins is None:  # the env's own choices for a Discrete/MultiDiscrete space (default_bins)
                 bins, grows = default_bins(made_env.action_space)
@@ -204,7 +225,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self.bin_levels = bin_levels_from(bins) if bins is not None else []
         super().__init__(
             policy, made_env if made_env is not None else env, learning["learning_rate"], learning["buffer_size"],
-            learning["learning_starts"], learning["batch_size"], learning["tau"], learning["gamma"], train_freq,
+            learning["learning_starts"], learning["batch_size"], learning["tau"], learning["gamma"], learning["train_freq"],
             learning["gradient_steps"],
             action_noise=None,  # exploration is epsilon-greedy over the active bins
             replay_buffer_class=replay_buffer_class, replay_buffer_kwargs=replay_buffer_kwargs,
@@ -232,6 +253,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         # load() sets the file's attributes and its own keyword arguments on the model before this runs: those of
         # earlier releases are moved where this one keeps them, and every setting is checked as the constructor does
         upgrade_saved_settings(self.__dict__)
+        check_action_choices(self.action_space)
         if self.bins is None:  # built without an env: the action space's default now
             self.bins, grows = default_bins(self.action_space)
             if not grows:
@@ -253,6 +275,9 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self._check_decoding()
         #: the precision the updates run in: ``precision`` with ``"auto"`` resolved for this device
         self.update_precision = checked_precision(self.precision, self.device)
+        note = resolution_note(self.precision, self.device)
+        if note is not None and self.verbose >= 1:
+            print(f"{type(self).__name__}: {note}")
         # a file whose policy_kwargs name no torso was built with the torso of its release (a model built here names it)
         self.policy_kwargs = with_default_torso(self.policy_kwargs, SAVED_BEFORE_DEFAULT_TORSO)
         # the policy keeps the averaged acting networks only when they are averaged (SB3 passes use_sde the same way)
@@ -368,7 +393,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self.logger.record("train/q_mean", th.stack(q_values).mean().item())
         self.logger.record("growth/active_bins", self.active_bins)
         if prioritized is not None:
-            self.logger.record("replay/importance_sampling_exponent", prioritized.beta)
+            self.logger.record("replay/beta", prioritized.beta)
             self.logger.record("replay/max_priority", prioritized.max_priority)
 
     # ----------------------------------------------------------------------------------------------
@@ -390,6 +415,8 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
             total_timesteps, callbacks, reset_num_timesteps, tb_log_name, progress_bar
         )
         check_finite_observation(self._last_obs, "the env's reset")
+        # the arithmetic of this run's updates ("auto" resolved), a string: text in TensorBoard, a column in csv
+        self.logger.record("train/precision", self.update_precision)
         warn_if_learn_does_not_train(self.gradient_steps, total_timesteps, self.learning_starts)
         return total_timesteps, callback
 
@@ -397,7 +424,7 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         self: SelfGQN,
         total_timesteps: int,
         callback: MaybeCallback = None,
-        log_interval: int = 4,
+        log_interval: int | None = 4,
         tb_log_name: str = "GQN",
         reset_num_timesteps: bool = True,
         progress_bar: bool = False,
@@ -405,11 +432,17 @@ class GQN(SavedFiles, GrowingResolution, Acting, OffPolicyAlgorithm):
         return super().learn(
             total_timesteps=check_total_timesteps(total_timesteps),
             callback=callback,
-            log_interval=log_interval,
+            log_interval=check_log_interval(log_interval),  # type: ignore[arg-type]  # None: SB3's collect never dumps
             tb_log_name=tb_log_name,
             reset_num_timesteps=reset_num_timesteps,
             progress_bar=progress_bar,
         )
+
+    def set_env(self, env: GymEnv | str, force_reset: bool = True) -> None:
+        """SB3's ``set_env``, taking an env id as the constructor does (``model.set_env("Pendulum-v1")``)."""
+        made_env = resolve_env(env)
+        assert made_env is not None, "resolve_env returns None only for None"
+        super().set_env(made_env, force_reset)
 
     def _excluded_save_params(self) -> list[str]:
         excluded = ["q_net", "q_net_target", "_active_bin_indices", "_learning_bins_mask", "action_grid", "update_precision"]

@@ -19,6 +19,7 @@ from stable_baselines3.her.her_replay_buffer import HerReplayBuffer
 
 from sb3_gqn.common.buffers import PRIORITIZED, PrioritizedSampling
 from sb3_gqn.common.compact_buffer import compact, expand
+from sb3_gqn.common.envs import resolve_env
 from sb3_gqn.common.module_aliases import quiet_old_paths
 from sb3_gqn.gqn.growth.schedules import (
     AdaptiveGrowth,
@@ -209,12 +210,17 @@ class SavedFiles:
     @classmethod
     def load(cls, path: SavedPath, *args: Any, **kwargs: Any) -> Any:
         """SB3's ``load``, after checking that the file holds a model of this class (GQN, or DecQN for
-        ``DecQN.load``; a GQN file with static bins loads into either). Keyword arguments set the model's settings as
-        in SB3; ``growth_kwargs`` change the warm start and the adaptive schedule's settings, whose state goes on, and
-        the 0.2 keywords (``growth_patience=3``, ...) still work, with a ``DeprecationWarning``
-        (:func:`upgrade_saved_settings`). Files of 0.1.0, which name their classes by the old module paths, load
-        without a warning (:func:`~sb3_gqn.common.module_aliases.quiet_old_paths`)."""
+        ``DecQN.load``; a GQN file with static bins loads into either); ``env`` may be an env id, as in the
+        constructor. Keyword arguments set the model's settings as in SB3; ``growth_kwargs`` change the warm start and
+        the adaptive schedule's settings, whose state goes on, and the 0.2 keywords (``growth_patience=3``, ...) still
+        work, with a ``DeprecationWarning`` (:func:`upgrade_saved_settings`). Files of 0.1.0, which name their classes
+        by the old module paths, load without a warning (:func:`~sb3_gqn.common.module_aliases.quiet_old_paths`)."""
         check_model_file(path)
+        # an env id, as the constructor takes one (SB3's load takes only made envs)
+        if args:
+            args = (resolve_env(args[0]), *args[1:])
+        elif kwargs.get("env") is not None:
+            kwargs["env"] = resolve_env(kwargs["env"])
         deprecated = {key: kwargs.pop(key) for key in list(kwargs) if key in DEPRECATED_KEYWORDS}
         if deprecated:
             given = {group: kwargs.get(group) for group in GROUPS}

@@ -76,12 +76,20 @@ class GrowthCallback(BaseCallback):
 def with_growth_callback(callback: MaybeCallback, env_was_reset: bool, new_run: bool = True) -> list[BaseCallback]:
     """``learn``'s ``callback`` as a list with a :class:`GrowthCallback` in front of the user's callbacks.
 
-    :raises ValueError: for a ``callback`` that is not a ``BaseCallback``, a list of them, a callable or ``None``
+    :raises ValueError: for a ``callback`` that is not a ``BaseCallback``, a list of them (or of callables), a callable
+        or ``None``; for a list, naming the entry
     """
     if callback is None:
         user_callbacks: list[BaseCallback] = []
     elif isinstance(callback, list):
-        user_callbacks = list(callback)
+        user_callbacks = []
+        for index, entry in enumerate(callback):  # SB3's CallbackList would fail on the first step, after storing
+            if isinstance(entry, BaseCallback):
+                user_callbacks.append(entry)
+            elif callable(entry):
+                user_callbacks.append(ConvertCallback(entry))
+            else:
+                raise ValueError(f"callback[{index}] must be a BaseCallback or a callable, got {entry!r}")
     elif isinstance(callback, BaseCallback):
         user_callbacks = [callback]
     elif callable(callback):

@@ -10,7 +10,7 @@ one it acts on (the deployed level), and the two moves between levels, :meth:`~G
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import torch as th
@@ -60,6 +60,16 @@ class GrowingResolution:
         self.deployments = []
         self._deployed_level = None
         self.growth_schedule = schedule if growth == "adaptive" else None
+
+    @property
+    def growth_kwargs(self) -> dict[str, Any]:
+        """The growth settings in the constructor's spelling, a new dict: ``init`` (:attr:`growth_init`) and, with the
+        adaptive schedule, its settings (:meth:`AdaptiveGrowth.settings
+        <sb3_gqn.gqn.growth.schedules.AdaptiveGrowth.settings>`, the values it runs with):
+        ``GQN(..., growth=model.growth, growth_kwargs=model.growth_kwargs)`` grows as the model does. Read-only;
+        ``GQN.load(path, growth_kwargs=...)`` changes them."""
+        settings = {} if self.growth_schedule is None else self.growth_schedule.settings()
+        return {"init": self.growth_init, **settings}
 
     @property
     def active_bins(self) -> int:

@@ -43,6 +43,15 @@ RETURN_SOURCES = ("evaluation", "training")
 DEFAULT_EVAL_FRACTION = 0.05
 
 
+#: The most bins per action dimension GQN and DecQN take (``bins``, and the choices of a ``Discrete`` or
+#: ``MultiDiscrete`` action space): ``2 ** 10 + 1``, a nested level (ten doublings above 2 bins, four above the
+#: paper's finest resolution, 65 bins in its Meta-World setting), whose neighbouring bins are 1/1024 of the action range
+#: apart. The critic's head then holds at most ``1025 * action_dims`` outputs (0.5M weights per action dimension on a
+#: 512-wide torso, each copied into the target and acting networks and the optimizer's state); beyond the limit a typo
+#: such as ``bins=10**9`` would allocate until memory runs out instead of failing.
+MAX_BINS = 1025
+
+
 def _is_bin_count(value: object) -> TypeGuard[int | np.integer]:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
@@ -55,7 +64,8 @@ def nested_bin_levels(initial: int, final: int) -> list[int]:
     ``(9, 9)`` gives ``[9]``.
 
     :raises ValueError: naming ``bins``, if either is not an integer (``2.0``, ``"9"``, ``True``), either is below 2,
-        or ``final`` cannot be reached by doubling from ``initial`` (e.g. ``(2, 8)`` or ``(4, 9)``)
+        ``final`` exceeds :data:`MAX_BINS`, or ``final`` cannot be reached by doubling from ``initial`` (e.g. ``(2, 8)``
+        or ``(4, 9)``); before anything is allocated
     """
     for name, value in (("initial", initial), ("final", final)):
         if not _is_bin_count(value):
@@ -65,6 +75,11 @@ def nested_bin_levels(initial: int, final: int) -> list[int]:
         raise ValueError(f"bins: the coarsest level needs at least 2 bins per dimension, got {initial}")
     if final < initial:
         raise ValueError(f"bins=({initial}, {final}): the final resolution must not be below the initial one")
+    if final > MAX_BINS:
+        raise ValueError(
+            f"bins: at most MAX_BINS={MAX_BINS} bins per action dimension (four doublings above the paper's finest, 65), "
+            f"got {final}"
+        )
     levels = [initial]
     while levels[-1] < final:
         levels.append(2 * levels[-1] - 1)
@@ -80,7 +95,7 @@ def bin_levels_from(bins: int | tuple[int, int] | list[int]) -> list[int]:
     """``9`` -> ``[9]`` (static); ``(2, 9)`` -> ``[2, 3, 5, 9]`` (see :func:`nested_bin_levels`).
 
     :raises ValueError: naming ``bins`` for anything else: ``"9"``, ``2.5``, ``True``, ``None``, ``(2, 5, 9)``,
-        ``(2.0, 9)``, or bins that cannot nest
+        ``(2.0, 9)``, more than :data:`MAX_BINS`, or bins that cannot nest
     """
     if _is_bin_count(bins):
         return nested_bin_levels(int(bins), int(bins))
@@ -100,6 +115,23 @@ def checked_bins(bins: int | tuple[int, int] | list[int]) -> int | tuple[int, in
 DEFAULT_INITIAL_BINS = 3
 
 
+def check_action_choices(action_space: spaces.Space) -> None:
+    """Refuse a ``Discrete`` or ``MultiDiscrete`` action space with more than :data:`MAX_BINS` choices per dimension
+    (the critic's head would hold one output per choice), with a ``ValueError`` naming it, before anything is built.
+    Other spaces pass (a ``Box`` is discretized to ``bins``, checked on their own)."""
+    if isinstance(action_space, spaces.Discrete):
+        choices = int(action_space.n)
+    elif isinstance(action_space, spaces.MultiDiscrete):
+        choices = int(np.max(action_space.nvec)) if np.size(action_space.nvec) else 0
+    else:
+        return
+    if choices > MAX_BINS:
+        raise ValueError(
+            f"the env's action space {action_space} has {choices} choices per dimension: GQN and DecQN take at most "
+            f"MAX_BINS={MAX_BINS} (one output of the critic's head per choice)"
+        )
+
+
 def default_bins(action_space: spaces.Space) -> tuple[int | tuple[int, int], bool]:
     """``bins`` for ``action_space`` when none are given, and whether they grow (more than one level).
 
@@ -109,7 +141,10 @@ def default_bins(action_space: spaces.Space) -> tuple[int | tuple[int, int], boo
       otherwise (2, 3, 4, 6, 7, ...) ``n`` is a static resolution. ``CartPole-v1`` (``Discrete(2)``) gets ``2``,
       ``Acrobot-v1`` (``Discrete(3)``) ``3``, ``MultiDiscrete([9, 9])`` ``(3, 9)``.
     - Any other space (an uneven ``MultiDiscrete`` too): ``(3, 9)``; the action-space check then says what is wrong.
+
+    :raises ValueError: for more than :data:`MAX_BINS` choices per dimension (:func:`check_action_choices`)
     """
+    check_action_choices(action_space)
     choices: int | None = None
     if isinstance(action_space, spaces.Discrete):
         choices = int(action_space.n)
@@ -386,12 +421,13 @@ class AdaptiveGrowth:
 
         A new run (``new_run``: ``learn()`` with ``reset_num_timesteps=True``) fixes :attr:`budget` to its ``budget``
         (its ``total_timesteps``); a continued one (``reset_num_timesteps=False``, a resumed run) keeps the budget fixed
-        before, and takes ``budget`` only when none is. When the env was reset (new run, ``set_env``, load), the
+        before, and takes ``budget`` only when none is. A run of no steps (``learn(0)``) fixes none: the cadence of
+        a run continued after it reads that run's budget. When the env was reset (new run, ``set_env``, load), the
         episodes in progress are gone: their partial returns are dropped and greedy evaluation episodes that were
         running are started again. A run whose step counter was reset evaluates one cadence on.
         """
-        if budget is not None and (new_run or self.budget is None):
-            self.budget = int(budget)
+        if budget is not None and (new_run or not self.budget):
+            self.budget = int(budget) if budget > 0 else None
         cadence = self.steps_between_readings
         if self.next_eval_step == 0 or self.next_eval_step > num_timesteps + cadence:
             self.next_eval_step = num_timesteps + cadence
