@@ -779,9 +779,11 @@ def test_the_main_job_sentence_reads_the_committed_reference_runs(tmp_path):
             "growth_events": [{"step": step, "active_bins": bins} for step, bins in events],
         }
         (run / "final_evaluation.json").write_text(json.dumps(summary))
+        curve = [500.0, 875.0] if seed == 0 else [812.4]  # seed 0 ends at 700 / 875 = 0.80 of its best
+        (run / "learning_curve.csv").write_text("step,return_\n" + "".join(f"{k},{v}\n" for k, v in enumerate(curve)))
     sentence = page.main_job_block(tmp_path)
     assert "Over seeds 0, 1 of the committed runs (`docs/results/reference_run/`, each made as `make results`" in sentence
-    assert "the final greedy return is 700-812 (10 episodes each)" in sentence
+    assert "the final greedy return is 700-812 (10 episodes each), 0.80-1.00 of each seed's best evaluation" in sentence
     assert "the levels open to 3 at 9k-12k steps, to 5 at 20k-30k steps, to 9 at 40k-40k steps (1 of 2 seeds)" in sentence
     assert "training runs at 150-172 env steps/s" in sentence
 
@@ -799,10 +801,12 @@ def test_the_main_job_sentence_refuses_runs_not_made_as_make_results_makes_them(
 
 def test_make_results_runs_the_main_job_as_the_sentence_assumes():
     """The Makefile's reference-run line parses to :data:`MAIN_JOB_ARGS` (seed 0)."""
-    from sb3_gqn.experiments.reference_run import parse_args
+    from sb3_gqn.experiments.reference_run import load_hyperparams, parse_args, resolve_resolution
 
     makefile = (REPOSITORY / "Makefile").read_text()
     line = next(line for line in makefile.splitlines() if "sb3-gqn reference-run" in line)
-    args = vars(parse_args(line.split("reference-run", 1)[1].split()))
+    parsed = parse_args(line.split("reference-run", 1)[1].split())
+    resolve_resolution(parsed, load_hyperparams(parsed.hyperparams, parsed.env))  # bins and growth: the entry's
+    args = vars(parsed)
     expected = results_page().MAIN_JOB_ARGS
     assert {key: args[key] for key in expected} == expected and args["seed"] == 0

@@ -24,6 +24,7 @@ from typing import Any
 
 os.environ.setdefault("MUJOCO_GL", "disable")  # no rendering: keep dm_control off any GL backend
 
+import numpy as np
 import torch as th
 from stable_baselines3.common.logger import configure
 from stable_baselines3.common.monitor import Monitor
@@ -176,18 +177,18 @@ def plot_seeds(run_dirs: Sequence[Path], path: Path) -> None:
         with open(run_dir / "learning_curve.csv", newline="") as handle:
             rows = list(csv.DictReader(handle))
         summary = json.loads((run_dir / "final_evaluation.json").read_text())
-        steps = [0, *(int(row["step"]) for row in rows)]
-        returns = [float("nan"), *(float(row["return_"]) for row in rows)]
-        (line,) = axis.plot(steps[1:], returns[1:], marker="o", markersize=3, label=f"seed {summary['args']['seed']}")
+        steps = [int(row["step"]) for row in rows]
+        returns = [float(row["return_"]) for row in rows]
+        (line,) = axis.plot(steps, returns, marker="o", markersize=3, label=f"seed {summary['args']['seed']}")
         for event in summary["growth_events"]:
-            # the return where the level opened: the curve's value at the last evaluation before it
-            before = max(index for index, step in enumerate(steps) if step <= int(event["step"]))
-            if before > 0:
-                axis.plot(int(event["step"]), returns[before], marker="^", color=line.get_color(), markersize=7)
-                axis.annotate(
-                    str(event["active_bins"]), (int(event["step"]), returns[before]), textcoords="offset points",
-                    xytext=(0, 6), ha="center", fontsize=7, color=line.get_color(),
-                )  # fmt: skip
+            # on the curve where the level opened (between the evaluations around it)
+            step = int(event["step"])
+            height = float(np.interp(step, steps, returns))
+            axis.plot(step, height, marker="^", color=line.get_color(), markersize=7)
+            axis.annotate(
+                str(event["active_bins"]), (step, height), textcoords="offset points", xytext=(0, 6), ha="center",
+                fontsize=7, color=line.get_color(),
+            )  # fmt: skip
     axis.set_xlabel("environment steps")
     axis.set_ylabel("episode return (greedy, penalized)")
     axis.set_title("main job: GQN's class defaults on cartpole-swingup, c = 0.1 (triangles: bins opened)", fontsize=9)
