@@ -161,7 +161,7 @@ def test_growth_none_through_the_cli(tmp_path):
 @pytest.mark.parametrize(
     "arguments, code, message",
     [
-        (["--algo", "nope", "--env", "Pendulum-v1"], 2, "invalid choice: 'nope'"),
+        (["--algo", "nope", "--env", "Pendulum-v1"], 2, "--algo 'nope' is not an algorithm"),
         (["--algo", "gqn", "--env", "NoSuchEnv-v0"], 1, "NoSuchEnv-v0 not found in gym registry"),
         (["--algo", "gqn", "--env", "Pendulum-v1", "-params", "not_a_gqn_argument:1"], 1, "not_a_gqn_argument"),
         (["--algo", "gqn", "--env", "Pendulum-v1", "-params", "bins:(2,8)"], 1, "cannot be nested"),
