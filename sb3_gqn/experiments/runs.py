@@ -87,18 +87,22 @@ _XLA_THREAD_FLAGS = ("--xla_cpu_multi_thread_eigen", "intra_op_parallelism_threa
 
 
 def bound_jax_threads(threads: int) -> None:
-    """Bound JAX's CPU threads (SBX's agents) to ``threads``, as ``torch.set_num_threads`` bounds torch's: XLA's
-    ``--xla_cpu_multi_thread_eigen=false`` (one thread) or ``intra_op_parallelism_threads=threads`` in ``XLA_FLAGS``,
-    its other flags kept. XLA reads them when JAX makes its CPU backend, so a run sets them before its first JAX
-    computation; a backend made earlier in the process keeps its pools (a warning says so)."""
+    """Keep JAX (SBX's agents) to one CPU thread for its computations when a run has one thread, as
+    ``torch.set_num_threads(1)`` keeps torch: ``--xla_cpu_multi_thread_eigen=false`` in ``XLA_FLAGS``, its other flags
+    kept. XLA has no flag for another count, so with more threads its own default stays (the thread flags a user set
+    are dropped then too, as ``threads`` decides). XLA reads the flags when JAX makes its CPU backend, so a run sets
+    them before its first JAX computation; a backend made earlier in the process keeps its pools (a warning says so)."""
     import sys
 
     kept = [flag for flag in os.environ.get("XLA_FLAGS", "").split() if not flag.startswith(_XLA_THREAD_FLAGS)]
-    bounded = ["--xla_cpu_multi_thread_eigen=false"] if threads == 1 else []
-    os.environ["XLA_FLAGS"] = " ".join([*kept, *bounded, f"intra_op_parallelism_threads={threads}"])
+    flags = [*kept, "--xla_cpu_multi_thread_eigen=false"] if threads == 1 else kept
+    if flags:
+        os.environ["XLA_FLAGS"] = " ".join(flags)
+    else:
+        os.environ.pop("XLA_FLAGS", None)
     backends = getattr(sys.modules.get("jax._src.xla_bridge"), "_backends", None)
-    if backends:
-        warnings.warn(f"JAX made its backend before --threads {threads} could bound it: its thread pools stay", stacklevel=2)
+    if backends and threads == 1:
+        warnings.warn("JAX made its backend before --threads 1 could bound it: its thread pools stay", stacklevel=2)
 
 
 def curve_row(spec: RunSpec, row: dict[str, Any]) -> dict[str, Any]:
