@@ -47,6 +47,7 @@ from torch import nn
 from sb3_gqn import GQN, DecQN
 from sb3_gqn.common.envs import make_env
 from sb3_gqn.common.precision import has_bf16_matrix_units
+from sb3_gqn.experiments.runs import bound_jax_threads
 
 CARTPOLE = "dm_control/cartpole-swingup-v0"
 WALKER = "dm_control/walker-walk-v0"
@@ -189,10 +190,11 @@ def training_agents(env_id: str, device: str) -> dict[str, Callable[[], BaseAlgo
     return agents
 
 
-def training_speeds(env_id: str, rounds: int, chunk: int, device: str) -> dict[str, float]:
-    """Median env steps/s of each agent over ``rounds`` interleaved chunks of ``chunk`` training steps."""
+def training_speeds(agents: dict[str, Callable[[], BaseAlgorithm]], rounds: int, chunk: int) -> dict[str, float]:
+    """Median env steps/s of each agent over ``rounds`` interleaved chunks of ``chunk`` training steps, after each has
+    filled its warm-up (``learning_starts``) and trained 500 steps."""
     models = {}
-    for name, make_model in training_agents(env_id, device).items():
+    for name, make_model in agents.items():
         model = make_model()
         model.learn(model.learning_starts + 500)  # type: ignore[attr-defined]
         models[name] = model
@@ -215,8 +217,7 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="CPU threads of torch and of JAX (SBX) alike")
     args = parser.parse_args()
     th.set_num_threads(args.threads)
-    if args.threads == 1:  # before JAX is imported: XLA's CPU client otherwise spreads over every core
-        os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1")
+    bound_jax_threads(args.threads)  # before JAX makes its CPU backend, as the runner does
     device = args.device
     if th.device(device).type == "cuda" and not th.cuda.is_available():
         parser.error(f"--device {device}: torch sees no CUDA device on this machine")
@@ -248,7 +249,7 @@ def main() -> None:
         print(f"| {name} | {seconds * 1e6:.1f} | {seconds / costs['bare']:.2f}x |")
 
     for env_id in (WALKER, HUMANOID):
-        speeds = training_speeds(env_id, args.rounds, args.chunk, device)
+        speeds = training_speeds(training_agents(env_id, device), args.rounds, args.chunk)
         print(f"\nEnv steps/s while training on {env_id} (c = 0.1), median of {args.rounds} interleaved rounds")
         print("| agent | env steps/s | s / 1 000 steps | vs GQN (defaults) |")
         print("| --- | ---: | ---: | ---: |")

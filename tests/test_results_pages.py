@@ -221,6 +221,33 @@ def test_the_mujoco_goal_by_hand(mujoco, monkeypatch):
     )
 
 
+def test_the_goal_reads_sac_cost_from_the_benchmark_by_hand(mujoco, tmp_path, monkeypatch):
+    """Without our SAC's runs the goal reads SAC's core-hours from the training-cost benchmark: GQN 1.0 and 1.5
+    core-hours per 1M steps on HalfCheetah and Hopper, SBX SAC 4.0 and 6.0, so 2.5 / 10 = 0.25x (SB3 SAC 10 and 10:
+    0.125x). With the 3 of 5 tasks above, the goal is met; at SBX SAC 3.0 and 4.0 (2.5 / 7 = 0.36x) it is not."""
+    monkeypatch.setattr(mujoco, "GQN_SEEDS", 1)
+    values = {"HalfCheetah-v5": 10000, "Hopper-v5": 2000, "Walker2d-v5": 4000, "Ant-v5": 4000, "Humanoid-v5": 7000}
+    rows = pd.DataFrame([mujoco_run("gqn-adaptive", env, 0, value) for env, value in values.items()])
+    path = tmp_path / "training_cost.csv"
+    table = [("GQN", 1.0, 1.5), ("SBX SAC", 4.0, 6.0), ("SB3 SAC", 10.0, 10.0), ("DecQN-9", 1.0, 1.5)]
+    cells = [(env, agent, hours[i]) for agent, *hours in table for i, env in enumerate(("HalfCheetah-v5", "Hopper-v5"))]
+    pd.DataFrame(cells, columns=["env", "agent", "core_hours_per_1m"]).to_csv(path, index=False)
+    cost = mujoco.training_cost(path)
+    assert mujoco.goal_block(rows, cost) == (
+        "GQN at or above the zoo's SAC on 3 of 5 tasks (HalfCheetah-v5, Walker2d-v5, Humanoid-v5); at 0.25x SBX SAC's "
+        "core-hours per 1M training steps (the training-cost benchmark, one run: HalfCheetah-v5, Hopper-v5). The goal "
+        "(at or above the zoo's SAC on at least 3 of 5 tasks, at 0.25x SAC's core-hours or less) is met."
+    )
+    block = mujoco.cost_block(cost).splitlines()
+    assert block[0] == "| task | GQN | DecQN-9 | SB3 SAC | SBX SAC |"
+    assert block[2] == "| HalfCheetah-v5 | 1.00 | 1.00 | 10.00 | 4.00 |"
+    assert block[-1] == "GQN's core-hours, summed over these tasks: 1.00x DecQN-9's, 0.12x SB3 SAC's, 0.25x SBX SAC's."
+    cost.loc[:, "SBX SAC"] = [3.0, 4.0]
+    assert mujoco.goal_block(rows, cost).endswith("is not met.") and "at 0.36x SBX SAC's" in mujoco.goal_block(rows, cost)
+    assert mujoco.cost_block(None).startswith("Not run yet: `python benchmarks/mujoco_cost.py")
+    assert mujoco.training_cost(tmp_path / "absent.csv") is None
+
+
 def test_the_configuration_rule_by_hand(mujoco):
     """Scores (final return over the zoo's SAC, averaged over HalfCheetah and Hopper): A 0.50, B 0.60 (not 25 % above
     A's), C 0.52 (within 5 % of A's): A. B at 0.65 (30 % above): B. C at 0.60: C."""
@@ -243,11 +270,11 @@ def test_the_configuration_rule_by_hand(mujoco):
 
 def test_the_mujoco_page_before_any_run(mujoco, tmp_path):
     names = ["mujoco-configuration-table", "mujoco-configuration", "mujoco-table", "mujoco", "mujoco-figures"]
-    names += ["mujoco-goal"]
+    names += ["mujoco-cost", "mujoco-goal"]
     page, readme = tmp_path / "page.md", tmp_path / "README.md"
     page.write_text("".join(f"<!-- BEGIN generated: {name} -->\n<!-- END generated: {name} -->\n" for name in names))
     readme.write_text("<!-- BEGIN generated: mujoco-status -->\n<!-- END generated: mujoco-status -->\n")
-    mujoco.rebuild(page, readme, tmp_path / "runs", tmp_path / "runs" / "configuration")
+    mujoco.rebuild(page, readme, tmp_path / "runs", tmp_path / "runs" / "configuration", tmp_path / "cost.csv")
     text = page.read_text()
     assert "Not run yet: `runs/results.csv` does not exist until the first run finishes." in text
     assert "Not run yet: `runs/configuration/results.csv` does not exist until the first run finishes." in text

@@ -35,6 +35,9 @@ AGENTS: dict[str, str] = MUJOCO["agents"]
 GQN, SAC = str(MUJOCO["gqn"]), str(MUJOCO["sac"])
 GQN_SEEDS = int(MUJOCO["gqn_seeds"])
 GOAL_TASKS, GOAL_CORE_HOURS = int(MUJOCO["goal"]["tasks"]), float(MUJOCO["goal"]["core_hours"])
+#: The training-cost benchmark's table (benchmarks/mujoco_cost.py) and its GQN and SAC rows: SAC's core-hours where
+#: our SAC has not run
+TRAINING_COST: dict = MUJOCO["training_cost"]
 #: The configuration probe: its folder, budget, tasks and candidates (runner name: the plan's letter)
 CONFIGURATION: dict = MUJOCO["configuration"]
 CONFIGURATION_FOLDER = Path(CONFIGURATION["folder"])
@@ -106,11 +109,31 @@ def at_or_above_sac(final: pd.DataFrame) -> list[str]:
     return [task for task in TASKS if task in means and means[task] >= ZOO[task]["SAC"][0]]
 
 
-def goal_parts(table: pd.DataFrame | None) -> tuple[str, str, str]:
+def training_cost(path: Path | None = None) -> pd.DataFrame | None:
+    """The training-cost benchmark's core-hours per 1M steps, task by agent (``None`` before it has run)."""
+    path = Path(TRAINING_COST["table"]) if path is None else path
+    if not path.is_file():
+        return None
+    return pd.read_csv(path).pivot(index="env", columns="agent", values="core_hours_per_1m")
+
+
+def cost_block(cost: pd.DataFrame | None) -> str:
+    """The benchmark's core-hours per 1M training steps per task and agent, and GQN's over each other agent's."""
+    if cost is None:
+        return "Not run yet: `python benchmarks/mujoco_cost.py --out docs/results/mujoco/training_cost.csv` writes it."
+    gqn = TRAINING_COST["gqn"]
+    agents = [gqn, *(agent for agent in cost.columns if agent != gqn)]
+    lines = ["| task | " + " | ".join(agents) + " |", "| --- |" + " ---: |" * len(agents)]
+    lines += [f"| {task} | " + " | ".join(f"{cost.loc[task, agent]:.2f}" for agent in agents) + " |" for task in cost.index]
+    ratios = ", ".join(f"{cost[gqn].sum() / cost[agent].sum():.2f}x {agent}'s" for agent in agents[1:])
+    return "\n".join([*lines, "", f"GQN's core-hours, summed over these tasks: {ratios}."])
+
+
+def goal_parts(table: pd.DataFrame | None, cost: pd.DataFrame | None = None) -> tuple[str, str, str]:
     """The goal's reading: on how many tasks GQN's mean final return is at or above rl-zoo3's SAC (once every task has
     :data:`GQN_SEEDS` finished GQN runs), GQN's core-hours per 1M steps over our SAC's, summed over the tasks both ran
-    (once our SAC has run), each "not yet readable" while runs are missing, and whether the goal is met once both
-    read."""
+    (once our SAC has run; before, the same ratio from the training-cost benchmark ``cost``, :func:`training_cost`),
+    each "not yet readable" while runs are missing, and whether the goal is met once both read."""
     final = final_rows(own_readings(finished_runs(table, BUDGET)))
     gqn, sac = final[final["algo"] == GQN], final[final["algo"] == SAC]
     seeds = [len(gqn[gqn["env"] == task]) for task in TASKS]
@@ -126,11 +149,16 @@ def goal_parts(table: pd.DataFrame | None) -> tuple[str, str, str]:
         if above is not None
         else f"GQN against the zoo's SAC: not yet readable ({done} of {GQN_SEEDS * len(TASKS)} GQN runs finished)"
     )
-    cost_part = (
-        f"at {ratio:.2f}x SAC's core-hours per 1M steps ({', '.join(both)})"
-        if ratio is not None
-        else "SAC's core-hours: not yet readable (no task with both GQN's and our SAC's runs)"
-    )
+    if ratio is not None:
+        cost_part = f"at {ratio:.2f}x SAC's core-hours per 1M steps ({', '.join(both)})"
+    elif cost is not None and {TRAINING_COST["gqn"], TRAINING_COST["sac"]} <= set(cost.columns):
+        ratio = float(cost[TRAINING_COST["gqn"]].sum() / cost[TRAINING_COST["sac"]].sum())
+        cost_part = (
+            f"at {ratio:.2f}x {TRAINING_COST['sac']}'s core-hours per 1M training steps (the training-cost benchmark, "
+            f"one run: {', '.join(cost.index)})"
+        )
+    else:
+        cost_part = "SAC's core-hours: not yet readable (no task with both GQN's and our SAC's runs)"
     goal = (
         f"at or above the zoo's SAC on at least {GOAL_TASKS} of {len(TASKS)} tasks, at {GOAL_CORE_HOURS:g}x SAC's "
         "core-hours or less"
@@ -142,9 +170,9 @@ def goal_parts(table: pd.DataFrame | None) -> tuple[str, str, str]:
     return returns_part, cost_part, verdict
 
 
-def goal_block(table: pd.DataFrame | None) -> str:
+def goal_block(table: pd.DataFrame | None, cost: pd.DataFrame | None = None) -> str:
     """The goal line (:func:`goal_parts`)."""
-    returns_part, cost_part, verdict = goal_parts(table)
+    returns_part, cost_part, verdict = goal_parts(table, cost)
     return f"{returns_part}; {cost_part}. {verdict}"
 
 
@@ -202,9 +230,9 @@ def configuration_block(table: pd.DataFrame | None) -> str:
     return "\n".join([*lines, "", f"{reading[0].upper()}{reading[1:]}."])
 
 
-def readme_line(table: pd.DataFrame | None, probe: pd.DataFrame | None) -> str:
+def readme_line(table: pd.DataFrame | None, probe: pd.DataFrame | None, cost: pd.DataFrame | None = None) -> str:
     """The README's line on the page: where the configuration probe and the runs stand."""
-    returns_part, cost_part, verdict = goal_parts(table)
+    returns_part, cost_part, verdict = goal_parts(table, cost)
     state = (
         f"{returns_part}; {cost_part}: {verdict[0].lower()}{verdict[1:]}"
         if "not yet readable" not in verdict
@@ -217,14 +245,19 @@ def readme_line(table: pd.DataFrame | None, probe: pd.DataFrame | None) -> str:
 
 
 def rebuild(
-    page: Path = PAGE, readme: Path = Path("README.md"), folder: Path = FOLDER, probe: Path = CONFIGURATION_FOLDER
+    page: Path = PAGE,
+    readme: Path = Path("README.md"),
+    folder: Path = FOLDER,
+    probe: Path = CONFIGURATION_FOLDER,
+    cost_table: Path | None = None,
 ) -> None:
     """Rewrite ``page``'s blocks and the README's line from the committed tables, whatever has run."""
-    table, probe_table = results_table(folder), results_table(probe)
+    table, probe_table, cost = results_table(folder), results_table(probe), training_cost(cost_table)
     replace_block(page, "mujoco-configuration-table", table_link(probe, page))
     replace_block(page, "mujoco-configuration", configuration_block(probe_table))
     replace_block(page, "mujoco-table", table_link(folder, page))
     replace_block(page, "mujoco", returns_block(table))
     replace_block(page, "mujoco-figures", curves_block(table, BUDGET, page, folder))
-    replace_block(page, "mujoco-goal", goal_block(table))
-    replace_block(readme, "mujoco-status", readme_line(table, probe_table))
+    replace_block(page, "mujoco-cost", cost_block(cost))
+    replace_block(page, "mujoco-goal", goal_block(table, cost))
+    replace_block(readme, "mujoco-status", readme_line(table, probe_table, cost))
