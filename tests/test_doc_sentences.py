@@ -52,6 +52,10 @@ EXCEPTIONS = {
     "myoHandPoseRandom-v0": "MyoSuite's hand tasks' (gamma 0.95, 2048 x 2048)",
     "myoHandReachFixed-v0": "MyoSuite's hand tasks'",
     "myoHandKeyTurnFixed-v0": "MyoSuite's hand tasks'",
+    **{
+        f"{task}-v5": "Gymnasium MuJoCo's (one update per 4 env steps"
+        for task in ("HalfCheetah", "Hopper", "Walker2d", "Ant", "Humanoid")
+    },
 }
 TUNED = ("dm_control/finger-spin-v0", "dm_control/walker-walk-v0")
 #: what an entry may set and still be the class defaults
