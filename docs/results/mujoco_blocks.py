@@ -117,6 +117,11 @@ def training_cost(path: Path | None = None) -> pd.DataFrame | None:
     return pd.read_csv(path).pivot(index="env", columns="agent", values="core_hours_per_1m")
 
 
+def cost_ratio(cost: pd.DataFrame, agent: str) -> float:
+    """GQN's core-hours over ``agent``'s in the benchmark's table, each summed over its tasks."""
+    return float(cost[TRAINING_COST["gqn"]].sum() / cost[agent].sum())
+
+
 def cost_block(cost: pd.DataFrame | None) -> str:
     """The benchmark's core-hours per 1M training steps per task and agent, and GQN's over each other agent's."""
     if cost is None:
@@ -125,7 +130,7 @@ def cost_block(cost: pd.DataFrame | None) -> str:
     agents = [gqn, *(agent for agent in cost.columns if agent != gqn)]
     lines = ["| task | " + " | ".join(agents) + " |", "| --- |" + " ---: |" * len(agents)]
     lines += [f"| {task} | " + " | ".join(f"{cost.loc[task, agent]:.2f}" for agent in agents) + " |" for task in cost.index]
-    ratios = ", ".join(f"{cost[gqn].sum() / cost[agent].sum():.2f}x {agent}'s" for agent in agents[1:])
+    ratios = ", ".join(f"{cost_ratio(cost, agent):.2f}x {agent}'s" for agent in agents[1:])
     return "\n".join([*lines, "", f"GQN's core-hours, summed over these tasks: {ratios}."])
 
 
@@ -152,7 +157,7 @@ def goal_parts(table: pd.DataFrame | None, cost: pd.DataFrame | None = None) -> 
     if ratio is not None:
         cost_part = f"at {ratio:.2f}x SAC's core-hours per 1M steps ({', '.join(both)})"
     elif cost is not None and {TRAINING_COST["gqn"], TRAINING_COST["sac"]} <= set(cost.columns):
-        ratio = float(cost[TRAINING_COST["gqn"]].sum() / cost[TRAINING_COST["sac"]].sum())
+        ratio = cost_ratio(cost, TRAINING_COST["sac"])
         cost_part = (
             f"at {ratio:.2f}x {TRAINING_COST['sac']}'s core-hours per 1M training steps (the training-cost benchmark, "
             f"one run: {', '.join(cost.index)})"
