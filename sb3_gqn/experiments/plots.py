@@ -62,6 +62,11 @@ AGENT_COLORS = {
     "sac": "tab:purple",
     "td3": "tab:brown",
     "sbx-sac": "darkviolet",
+    # the paper's presets, each its own shade of the agent it configures
+    "gqn-paper": "darkgreen",
+    "gqn-paper-linear": "yellowgreen",
+    "decqn-paper-2": "firebrick",
+    "decqn-paper-9": "steelblue",
 }
 #: the colours of the agents :data:`AGENT_COLORS` does not list (none of its colours)
 OTHER_COLORS = (
