@@ -280,7 +280,7 @@ def test_the_mujoco_page_before_any_run(mujoco, tmp_path):
     assert "Not run yet: `runs/configuration/results.csv` does not exist until the first run finishes." in text
     assert "| HalfCheetah-v5 | not finished | not finished | not finished | 9535 ± 100 |" in text
     assert "The plan's rule is not read yet (0 of 6 runs finished)." in text and "is not yet readable." in text
-    assert "in progress: the configuration probe: the plan's rule is not read yet" in readme.read_text()
+    assert "in progress; from the configuration probe, the plan's rule is not read yet" in readme.read_text()
 
 
 def test_the_pages_match_the_committed_tables(monkeypatch):

@@ -241,7 +241,7 @@ def readme_line(table: pd.DataFrame | None, probe: pd.DataFrame | None, cost: pd
     state = (
         f"{returns_part}; {cost_part}: {verdict[0].lower()}{verdict[1:]}"
         if "not yet readable" not in verdict
-        else f"in progress: the configuration probe: {configuration_reading(probe)}; {returns_part}; {cost_part}."
+        else f"in progress; from the configuration probe, {configuration_reading(probe)}; {returns_part}; {cost_part}."
     )
     return (
         "- **Gymnasium MuJoCo**, 1M steps ([page](docs/results/mujoco.md)): GQN on HalfCheetah, Hopper, Walker2d, Ant and "
