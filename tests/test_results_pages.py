@@ -94,9 +94,9 @@ def test_the_paper_protocol_claims_by_hand(protocol):
         "- Claim 3 (smoothness at matched task return): SM, GQN over DecQN-9: argmax 0.60x, relative 0.50x; final task "
         "return, GQN - DecQN-9: +50 [-50, +150] (matched)",
     ]
-    # humanoid-stand has no finished DecQN-9 run: each claim waits, with how many seeds each agent has finished
+    # humanoid-stand has no finished run: each claim waits, with how many seeds each agent has finished
     humanoid = body[body.index("**humanoid-stand, c = 0.5**") + 2 :][:3]
-    assert humanoid[0].endswith("GQN - DecQN-9: waiting for runs (0 of 2 seeds of each agent finished)")
+    assert humanoid[0].endswith("GQN - DecQN-9: waiting for runs (seeds finished of 2: GQN 0, DecQN-9 0)")
 
 
 def test_a_claim_waits_for_every_seed_of_its_agents(protocol, monkeypatch):
@@ -104,7 +104,7 @@ def test_a_claim_waits_for_every_seed_of_its_agents(protocol, monkeypatch):
     body = protocol.claims_block(finger_table()).splitlines()
     finger = body[body.index("**finger-turn_hard, c = 0.5**") + 2 :][:6]
     assert finger[0] == (
-        "- Claim 1, early (mean return up to 250k), GQN - DecQN-9: waiting for runs (2 of 3 seeds of each agent finished)"
+        "- Claim 1, early (mean return up to 250k), GQN - DecQN-9: waiting for runs (seeds finished of 3: GQN 2, DecQN-9 2)"
     )
     assert finger[4] == "- Claim 2 (against SAC): not read (the plan cuts SAC)"
 

@@ -98,8 +98,11 @@ def runs_finished(table: pd.DataFrame | None) -> tuple[int, int]:
 
 def waiting(runs: pd.DataFrame, agents: tuple[str, ...]) -> str | None:
     """Why a claim on ``agents`` is not read yet: the seeds each has finished of the plan's, while one lacks some."""
-    done = min(seeds_finished(runs, agent) for agent in agents)
-    return None if done >= len(SEEDS) else f"waiting for runs ({done} of {len(SEEDS)} seeds of each agent finished)"
+    done = {agent: seeds_finished(runs, agent) for agent in agents}
+    if min(done.values()) >= len(SEEDS):
+        return None
+    counts = ", ".join(f"{AGENTS[agent]} {count}" for agent, count in done.items())
+    return f"waiting for runs (seeds finished of {len(SEEDS)}: {counts})"
 
 
 def compared(values: pd.DataFrame, agent: str, baseline: str) -> str:
